@@ -1,0 +1,62 @@
+#pragma once
+/// @file
+/// The library's exception types and its debug assertion.
+///
+/// posefuse reports three kinds of failure differently (see STYLE.md §5):
+/// bad configuration throws posefuse::invalid_argument, unreadable or
+/// malformed files throw posefuse::io_error naming the file and line, and
+/// data failures on a per-sample hot path return a [[nodiscard]] status.
+
+#include <cstddef>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+
+namespace posefuse {
+
+/// A configuration value that the library cannot work with (negative
+/// variance, zero track width, mismatched lengths, ...).
+class invalid_argument : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+/// A file that cannot be read or is malformed. what() reads
+/// `"<file>:<line>: <reason>"` (or `"<file>: <reason>"` when no line applies).
+class io_error : public std::runtime_error {
+ public:
+  io_error(const std::filesystem::path& file, std::size_t line, const std::string& reason)
+      : std::runtime_error(format(file, line, reason)), file_(file), line_(line) {}
+  io_error(const std::filesystem::path& file, const std::string& reason)
+      : io_error(file, 0, reason) {}
+
+  /// The file the error is about.
+  [[nodiscard]] const std::filesystem::path& file() const noexcept { return file_; }
+  /// 1-based line number, or 0 when the error is not about one line.
+  [[nodiscard]] std::size_t line() const noexcept { return line_; }
+
+ private:
+  static std::string format(const std::filesystem::path& file, std::size_t line,
+                            const std::string& reason) {
+    std::string s = file.string();
+    if (line > 0) s += ":" + std::to_string(line);
+    return s + ": " + reason;
+  }
+  std::filesystem::path file_;
+  std::size_t line_;
+};
+
+}  // namespace posefuse
+
+#ifdef NDEBUG
+#define POSEFUSE_ASSERT(cond, msg) ((void)0)
+#else
+#include <cstdio>
+#include <cstdlib>
+/// Checks an internal invariant in debug builds; compiled out under NDEBUG.
+#define POSEFUSE_ASSERT(cond, msg)                                                    \
+  ((cond) ? (void)0                                                                   \
+          : (std::fprintf(stderr, "%s:%d: posefuse assertion '%s' failed: %s\n",      \
+                          __FILE__, __LINE__, #cond, msg),                            \
+             std::abort()))
+#endif
