@@ -1,0 +1,215 @@
+#pragma once
+/// @file
+/// The concepts every posefuse model and estimator is written against.
+///
+/// * A **manifold** type (states and measurements) has a scalar type, a
+///   compile-time tangent dimension `Dim`, and `plus` / `minus`
+///   (\f$ x \boxplus \delta \f$ and \f$ y \boxminus x \f$). Filters never use
+///   raw `+` / `-` on states, so angles wrap where a type says they do.
+///   Fixed-size Eigen column vectors are manifolds out of the box; other types
+///   provide member `plus(dx)` / `minus(y)` or specialise ManifoldTraits.
+/// * A **motion model** names its `State` and `Control` and gives
+///   \f$ f(x, u, \Delta t) \f$, its Jacobian \f$ J_{f,x} \f$ and the process noise.
+/// * A **measurement model** names its `State` and `Measurement` and gives
+///   \f$ h(x) \f$, its Jacobian \f$ J_{h,x} \f$ and the measurement noise.
+///
+/// Every header that defines a model ends with a `static_assert` of the
+/// matching concept. For readable diagnostics, `check_motion_model<M>()` and
+/// `check_measurement_model<H>()` assert one requirement at a time with a
+/// sentence saying which one a type misses.
+
+#include <Eigen/Core>
+#include <concepts>
+#include <type_traits>
+
+namespace posefuse {
+
+/// How a type behaves as a manifold. The primary template forwards to the
+/// type's members `Scalar`, `Dim`, `plus(dx)` and `minus(y)`.
+template <class S>
+struct ManifoldTraits {
+  using Scalar = typename S::Scalar;
+  static constexpr int Dim = S::Dim;
+  using Tangent = Eigen::Matrix<Scalar, Dim, 1>;
+  static S plus(const S& x, const Tangent& dx) { return x.plus(dx); }
+  static Tangent minus(const S& y, const S& x) { return y.minus(x); }
+};
+
+/// Fixed-size Eigen column vectors are Euclidean: plus is `+`, minus is `-`.
+template <class T, int N, int Options, int MaxRows, int MaxCols>
+  requires(N != Eigen::Dynamic)
+struct ManifoldTraits<Eigen::Matrix<T, N, 1, Options, MaxRows, MaxCols>> {
+  using Scalar = T;
+  static constexpr int Dim = N;
+  using Type = Eigen::Matrix<T, N, 1, Options, MaxRows, MaxCols>;
+  using Tangent = Eigen::Matrix<T, N, 1>;
+  static Type plus(const Type& x, const Tangent& dx) { return x + dx; }
+  static Tangent minus(const Type& y, const Type& x) { return y - x; }
+};
+
+/// Scalar type of a manifold.
+template <class S>
+using ScalarOf = typename ManifoldTraits<S>::Scalar;
+/// Tangent dimension of a manifold.
+template <class S>
+inline constexpr int DimOf = ManifoldTraits<S>::Dim;
+/// Tangent vector of a manifold (a fixed-size column vector).
+template <class S>
+using TangentOf = Eigen::Matrix<ScalarOf<S>, DimOf<S>, 1>;
+/// Covariance on a manifold's tangent space.
+template <class S>
+using CovarianceOf = Eigen::Matrix<ScalarOf<S>, DimOf<S>, DimOf<S>>;
+
+/// A type with a fixed tangent dimension and boxplus / boxminus.
+template <class S>
+concept Manifold = requires {
+  typename ManifoldTraits<S>::Scalar;
+  { ManifoldTraits<S>::Dim } -> std::convertible_to<int>;
+} && std::floating_point<ScalarOf<S>> && (DimOf<S> > 0) &&
+  requires(const S& x, const S& y, const TangentOf<S>& dx) {
+    { ManifoldTraits<S>::plus(x, dx) } -> std::convertible_to<S>;
+    { ManifoldTraits<S>::minus(y, x) } -> std::convertible_to<TangentOf<S>>;
+  };
+
+/// The estimated quantity of a filter.
+template <class S>
+concept State = Manifold<S>;
+
+/// A sensor reading; its `minus` is the residual (it wraps angles).
+template <class Z>
+concept Measurement = Manifold<Z>;
+
+/// \f$ x \boxplus \delta \f$.
+template <Manifold S>
+[[nodiscard]] inline S plus(const S& x, const TangentOf<S>& dx) {
+  return ManifoldTraits<S>::plus(x, dx);
+}
+/// \f$ y \boxminus x \f$: the tangent vector that takes x to y.
+template <Manifold S>
+[[nodiscard]] inline TangentOf<S> minus(const S& y, const S& x) {
+  return ManifoldTraits<S>::minus(y, x);
+}
+
+/// A motion model \f$ x_t = f(x_{t-1}, u_t, \Delta t) + w,\; w \sim N(0, Q) \f$.
+template <class M>
+concept MotionModel =
+    requires { typename M::State; typename M::Control; } && State<typename M::State> &&
+    requires(const M& m, const typename M::State& x, const typename M::Control& u,
+             ScalarOf<typename M::State> dt) {
+      { m.predict(x, u, dt) } -> std::convertible_to<typename M::State>;
+      { m.jacobian(x, u, dt) } -> std::convertible_to<CovarianceOf<typename M::State>>;
+      { m.noise(x, u, dt) } -> std::convertible_to<CovarianceOf<typename M::State>>;
+    };
+
+/// Jacobian of a measurement model, \f$ J_{h,x} \f$.
+template <class H>
+using MeasurementJacobianOf = Eigen::Matrix<ScalarOf<typename H::State>,
+                                            DimOf<typename H::Measurement>,
+                                            DimOf<typename H::State>>;
+
+/// A measurement model \f$ z = h(x) + v,\; v \sim N(0, R) \f$.
+template <class H>
+concept MeasurementModel =
+    requires { typename H::State; typename H::Measurement; } && State<typename H::State> &&
+    Measurement<typename H::Measurement> &&
+    std::same_as<ScalarOf<typename H::State>, ScalarOf<typename H::Measurement>> &&
+    requires(const H& h, const typename H::State& x) {
+      { h.predict(x) } -> std::convertible_to<typename H::Measurement>;
+      { h.jacobian(x) } -> std::convertible_to<MeasurementJacobianOf<H>>;
+      { h.noise() } -> std::convertible_to<CovarianceOf<typename H::Measurement>>;
+    };
+
+/// A measurement model of the state type S.
+template <class H, class S>
+concept MeasurementModelFor = MeasurementModel<H> && std::same_as<typename H::State, S>;
+
+/// Models whose state Jacobian is the identity at compile time may say so with
+/// `static constexpr bool kIdentityJacobian = true;`; estimators then skip
+/// the matrix products with it (seed 000's G = H = I).
+template <class M>
+inline constexpr bool has_identity_jacobian_v = [] {
+  if constexpr (requires { M::kIdentityJacobian; }) {
+    return bool(M::kIdentityJacobian);
+  } else {
+    return false;
+  }
+}();
+
+/// Asserts each requirement of MotionModel separately, so that the compiler's
+/// message names the one that is missing. Use in a `static_assert` or call
+/// from a template that takes a motion model.
+template <class M>
+consteval bool check_motion_model() {
+  static_assert(requires { typename M::State; },
+                "posefuse: a motion model must name its state type: `using State = ...;`");
+  static_assert(requires { typename M::Control; },
+                "posefuse: a motion model must name its control type: `using Control = ...;`");
+  if constexpr (requires { typename M::State; typename M::Control; }) {
+    static_assert(State<typename M::State>,
+                  "posefuse: the motion model's State is not a posefuse::State (a fixed-size "
+                  "Eigen vector, or a type with Scalar, Dim, plus(dx) and minus(y))");
+    if constexpr (State<typename M::State>) {
+      using S = typename M::State;
+      using U = typename M::Control;
+      using T = ScalarOf<S>;
+      static_assert(requires(const M& m, const S& x, const U& u, T dt) {
+                      { m.predict(x, u, dt) } -> std::convertible_to<S>;
+                    },
+                    "posefuse: a motion model needs `State predict(const State&, const Control&, "
+                    "Scalar dt) const`");
+      static_assert(requires(const M& m, const S& x, const U& u, T dt) {
+                      { m.jacobian(x, u, dt) } -> std::convertible_to<CovarianceOf<S>>;
+                    },
+                    "posefuse: a motion model needs `Matrix<Scalar, Dim, Dim> jacobian(const "
+                    "State&, const Control&, Scalar dt) const` (J_f_x)");
+      static_assert(requires(const M& m, const S& x, const U& u, T dt) {
+                      { m.noise(x, u, dt) } -> std::convertible_to<CovarianceOf<S>>;
+                    },
+                    "posefuse: a motion model needs `Matrix<Scalar, Dim, Dim> noise(const State&, "
+                    "const Control&, Scalar dt) const` (process noise)");
+    }
+  }
+  return MotionModel<M>;
+}
+
+/// Asserts each requirement of MeasurementModel separately (see
+/// check_motion_model).
+template <class H>
+consteval bool check_measurement_model() {
+  static_assert(requires { typename H::State; },
+                "posefuse: a measurement model must name its state type: `using State = ...;`");
+  static_assert(requires { typename H::Measurement; },
+                "posefuse: a measurement model must name its measurement type: "
+                "`using Measurement = ...;`");
+  if constexpr (requires { typename H::State; typename H::Measurement; }) {
+    static_assert(State<typename H::State>,
+                  "posefuse: the measurement model's State is not a posefuse::State");
+    static_assert(Measurement<typename H::Measurement>,
+                  "posefuse: the measurement model's Measurement is not a posefuse::Measurement "
+                  "(a fixed-size Eigen vector, or a type with Scalar, Dim, plus and minus)");
+    if constexpr (State<typename H::State> && Measurement<typename H::Measurement>) {
+      using S = typename H::State;
+      using Z = typename H::Measurement;
+      static_assert(std::same_as<ScalarOf<S>, ScalarOf<Z>>,
+                    "posefuse: State and Measurement of a measurement model must share a Scalar");
+      static_assert(requires(const H& h, const S& x) {
+                      { h.predict(x) } -> std::convertible_to<Z>;
+                    },
+                    "posefuse: a measurement model needs `Measurement predict(const State&) const` "
+                    "(h(x))");
+      static_assert(requires(const H& h, const S& x) {
+                      { h.jacobian(x) } -> std::convertible_to<MeasurementJacobianOf<H>>;
+                    },
+                    "posefuse: a measurement model needs `Matrix<Scalar, Measurement::Dim, "
+                    "State::Dim> jacobian(const State&) const` (J_h_x)");
+      static_assert(requires(const H& h) {
+                      { h.noise() } -> std::convertible_to<CovarianceOf<Z>>;
+                    },
+                    "posefuse: a measurement model needs `Matrix<Scalar, Measurement::Dim, "
+                    "Measurement::Dim> noise() const`");
+    }
+  }
+  return MeasurementModel<H>;
+}
+
+}  // namespace posefuse
