@@ -1,0 +1,449 @@
+#pragma once
+/// @file
+/// The recorded-log folder of seed 001's corridor experiment (issue 3, item 7):
+/// reader and writer with file:line errors.
+///
+/// A log is a folder holding
+///
+/// | file              | columns                                   | units                     |
+/// |-------------------|-------------------------------------------|---------------------------|
+/// | `wheels.csv`      | `t_ns,fl,fr,bl,br`                        | cumulative encoder ticks  |
+/// | `imu.csv`         | `t_ns,ax,ay,az,gx,gy,gz,mx,my,mz`         | m/s², rad/s, µT           |
+/// | `slam.csv`        | `t_ns,state,x,y,z,qx,qy,qz,qw`            | m, unit quaternion        |
+/// | `robot.txt`       | `key value` lines                         | see RobotLogParams        |
+/// | `groundtruth.csv` | `t_ns,x,y,yaw` (optional)                 | m, rad                    |
+///
+/// * IMU axes are the robot body frame of ROS REP-103 (x forward, y left,
+///   z up); the accelerometer reads specific force (+9.81 on z at rest).
+/// * `state` is `tracking`, `lost` or `reinit` (any letter case); a `reinit`
+///   row starts a new SLAM map frame (its pose is the first pose in that
+///   frame). The SLAM pose is the body pose in the current map frame, z up.
+///   In `lost` rows the pose is ignored and may be NaN or empty. Quaternions
+///   of other rows must have unit length within 1e-2.
+/// * The ground-truth world frame is the odometry frame: origin and heading
+///   of the robot at its first sample.
+/// * Lines starting with `#` are comments; blank lines are skipped; one
+///   column-name line without `#` (e.g. `t_ns,fl,fr,bl,br`) is accepted before
+///   the first data row. `\r\n` line ends and spaces around fields are fine.
+/// * `t_ns` must increase strictly within each file; the files need not share
+///   timestamps.
+///
+/// Every malformed input throws posefuse::io_error whose what() is
+/// `"<file>:<line>: <reason>"` (wrong column count, bad number, NaN/Inf,
+/// unknown state, non-increasing t_ns, unknown/duplicate/missing key,
+/// non-positive parameter, missing required file).
+
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <span>
+#include <string>
+#include <string_view>
+#include <system_error>
+#include <vector>
+
+#include <posefuse/core/error.hpp>
+
+namespace posefuse {
+
+/// One row of `wheels.csv`: cumulative ticks of the four wheels at `t_ns`.
+struct WheelRecord {
+  std::int64_t t_ns{0};  ///< timestamp (ns)
+  std::int64_t fl{0};    ///< front-left cumulative ticks
+  std::int64_t fr{0};    ///< front-right cumulative ticks
+  std::int64_t bl{0};    ///< back-left cumulative ticks
+  std::int64_t br{0};    ///< back-right cumulative ticks
+  friend bool operator==(const WheelRecord&, const WheelRecord&) = default;
+};
+
+/// One row of `imu.csv`, body frame x forward, y left, z up (REP-103).
+struct ImuRecord {
+  std::int64_t t_ns{0};                 ///< timestamp (ns)
+  std::array<double, 3> accel_mps2{};   ///< specific force (m/s²), +9.81 on z at rest
+  std::array<double, 3> gyro_radps{};   ///< angular rate (rad/s)
+  std::array<double, 3> mag_uT{};       ///< magnetic field (µT), as measured (uncalibrated)
+  friend bool operator==(const ImuRecord&, const ImuRecord&) = default;
+};
+
+/// Tracking state of a SLAM row.
+enum class SlamState {
+  kTracking,  ///< pose valid in the current map frame
+  kLost,      ///< no pose (the row's pose fields are ignored)
+  kReinit     ///< first pose of a new map frame
+};
+
+/// One row of `slam.csv`: body pose in the current SLAM map frame.
+struct SlamRecord {
+  std::int64_t t_ns{0};                   ///< timestamp (ns)
+  SlamState state{SlamState::kLost};      ///< tracking / lost / reinit
+  std::array<double, 3> p{};              ///< position (m) in the map frame
+  std::array<double, 4> q{0, 0, 0, 1};    ///< orientation quaternion (x, y, z, w)
+  friend bool operator==(const SlamRecord&, const SlamRecord&) = default;
+};
+
+/// One row of the optional `groundtruth.csv` (world = odometry frame).
+struct GroundTruthRecord {
+  std::int64_t t_ns{0};  ///< timestamp (ns)
+  double x{0};           ///< position x (m)
+  double y{0};           ///< position y (m)
+  double yaw{0};         ///< heading (rad)
+  friend bool operator==(const GroundTruthRecord&, const GroundTruthRecord&) = default;
+};
+
+/// The `robot.txt` parameters; all are required and must be positive.
+struct RobotLogParams {
+  double ticks_per_rev{0};        ///< encoder ticks per wheel revolution
+  double wheel_radius_m{0};       ///< wheel radius (m) — seed eq 9 (not the diameter)
+  double track_width_m{0};        ///< distance between left and right wheels (m), seed eq 9 `d`
+  double complementary_alpha{0};  ///< complementary-filter constant, 0 < alpha < 1 (seed eq 3-4)
+  double fuser_threshold{0};      ///< seed eq 15 threshold on O_diff (m·rad)
+  friend bool operator==(const RobotLogParams&, const RobotLogParams&) = default;
+};
+
+/// A whole recorded log (all streams kept in file order).
+struct RobotLog {
+  RobotLogParams params;                     ///< robot.txt
+  std::vector<WheelRecord> wheels;           ///< wheels.csv
+  std::vector<ImuRecord> imu;                ///< imu.csv
+  std::vector<SlamRecord> slam;              ///< slam.csv
+  std::vector<GroundTruthRecord> groundtruth;  ///< groundtruth.csv (empty when absent)
+  friend bool operator==(const RobotLog&, const RobotLog&) = default;
+};
+
+/// The text `slam.csv` uses for a state.
+[[nodiscard]] constexpr std::string_view to_string(SlamState s) noexcept {
+  return s == SlamState::kTracking ? "tracking" : s == SlamState::kLost ? "lost" : "reinit";
+}
+
+namespace detail {
+
+inline std::string_view trim(std::string_view s) noexcept {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
+  return s;
+}
+
+inline std::string lower(std::string_view s) {
+  std::string r(s);
+  for (char& c : r) c = (c >= 'A' && c <= 'Z') ? char(c - 'A' + 'a') : c;
+  return r;
+}
+
+/// Reads a text file as (line number, trimmed content) pairs, skipping blank
+/// and `#` lines.
+inline std::vector<std::pair<std::size_t, std::string>> read_content_lines(
+    const std::filesystem::path& file) {
+  if (!std::filesystem::is_regular_file(file)) throw io_error(file, "required file is missing");
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw io_error(file, "cannot open file");
+  std::vector<std::pair<std::size_t, std::string>> lines;
+  std::string line;
+  std::size_t n = 0;
+  while (std::getline(in, line)) {
+    ++n;
+    const std::string_view t = trim(line);
+    if (t.empty() || t.front() == '#') continue;
+    lines.emplace_back(n, std::string(t));
+  }
+  if (in.bad()) throw io_error(file, n, "read error");
+  return lines;
+}
+
+inline std::vector<std::string_view> split_csv(std::string_view s) {
+  std::vector<std::string_view> out;
+  for (;;) {
+    const std::size_t c = s.find(',');
+    out.push_back(trim(s.substr(0, c)));
+    if (c == std::string_view::npos) break;
+    s.remove_prefix(c + 1);
+  }
+  return out;
+}
+
+/// A cursor over one CSV data line that parses its fields in order.
+class CsvLine {
+ public:
+  CsvLine(const std::filesystem::path& file, std::size_t line, std::string_view text,
+          std::span<const std::string_view> names)
+      : file_(file), line_(line), names_(names), fields_(split_csv(text)) {
+    if (fields_.size() != names.size()) {
+      std::string expected;
+      for (std::size_t i = 0; i < names.size(); ++i) expected += (i ? "," : "") + std::string(names[i]);
+      throw io_error(file, line, "expected " + std::to_string(names.size()) + " columns (" +
+                                     expected + "), got " + std::to_string(fields_.size()));
+    }
+  }
+  std::int64_t integer() {
+    const std::string_view f = next();
+    std::string_view g = f;
+    if (!g.empty() && g.front() == '+') g.remove_prefix(1);
+    std::int64_t v = 0;
+    const auto [ptr, ec] = std::from_chars(g.data(), g.data() + g.size(), v);
+    if (g.empty() || ec != std::errc{} || ptr != g.data() + g.size()) fail("an integer", f);
+    return v;
+  }
+  double real(bool allow_non_finite = false) {
+    const std::string_view f = next();
+    if (allow_non_finite && f.empty()) return std::numeric_limits<double>::quiet_NaN();
+    std::string_view g = f;
+    if (!g.empty() && g.front() == '+') g.remove_prefix(1);
+    double v = 0;
+    const auto [ptr, ec] = std::from_chars(g.data(), g.data() + g.size(), v);
+    if (g.empty() || ec != std::errc{} || ptr != g.data() + g.size()) fail("a number", f);
+    if (!allow_non_finite && !std::isfinite(v))
+      throw io_error(file_, line_, "column '" + std::string(names_[i_ - 1]) +
+                                       "' is not finite ('" + std::string(f) + "')");
+    return v;
+  }
+  std::string_view text() { return next(); }
+  [[noreturn]] void error(const std::string& reason) const { throw io_error(file_, line_, reason); }
+  [[noreturn]] void fail(const char* what, std::string_view f) const {
+    throw io_error(file_, line_, "column '" + std::string(names_[i_ - 1]) + "' is not " + what +
+                                     " ('" + std::string(f) + "')");
+  }
+
+ private:
+  std::string_view next() { return fields_[i_++]; }
+  const std::filesystem::path& file_;
+  std::size_t line_;
+  std::span<const std::string_view> names_;
+  std::vector<std::string_view> fields_;
+  std::size_t i_ = 0;
+};
+
+/// True when a line is the file's column names (an uncommented header).
+inline bool is_column_header(std::string_view text, std::span<const std::string_view> names) {
+  const auto f = split_csv(text);
+  if (f.size() != names.size()) return false;
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    if (lower(f[i]) != names[i]) return false;
+  }
+  return true;
+}
+
+/// Parses every data line of a CSV file with `row(CsvLine&) -> Record`, and
+/// checks that t_ns increases strictly.
+template <class Record, class RowFn>
+std::vector<Record> read_csv(const std::filesystem::path& file,
+                             std::span<const std::string_view> names, RowFn row) {
+  std::vector<Record> out;
+  std::size_t prev_line = 0;
+  for (const auto& [n, text] : read_content_lines(file)) {
+    if (out.empty() && is_column_header(text, names)) continue;
+    CsvLine c(file, n, text, names);
+    Record r = row(c);
+    if (!out.empty() && r.t_ns <= out.back().t_ns)
+      throw io_error(file, n, "t_ns " + std::to_string(r.t_ns) +
+                                  " does not increase (previous row, line " +
+                                  std::to_string(prev_line) + ", has " +
+                                  std::to_string(out.back().t_ns) + ")");
+    out.push_back(r);
+    prev_line = n;
+  }
+  return out;
+}
+
+inline std::string fmt(double v) {
+  std::array<char, 64> buf{};
+  const auto r = std::to_chars(buf.data(), buf.data() + buf.size(), v);  // shortest round-trip
+  return std::string(buf.data(), r.ptr);
+}
+
+inline std::ofstream open_for_writing(const std::filesystem::path& file) {
+  std::ofstream out(file, std::ios::binary | std::ios::trunc);
+  if (!out) throw io_error(file, "cannot open file for writing");
+  return out;
+}
+
+inline constexpr std::array<std::string_view, 5> kWheelCols{"t_ns", "fl", "fr", "bl", "br"};
+inline constexpr std::array<std::string_view, 10> kImuCols{"t_ns", "ax", "ay", "az", "gx",
+                                                           "gy",   "gz", "mx", "my", "mz"};
+inline constexpr std::array<std::string_view, 9> kSlamCols{"t_ns", "state", "x",  "y", "z",
+                                                           "qx",   "qy",    "qz", "qw"};
+inline constexpr std::array<std::string_view, 4> kTruthCols{"t_ns", "x", "y", "yaw"};
+
+}  // namespace detail
+
+/// Reads `robot.txt` (`key value` lines, `#` comments, also after a value).
+/// @param[in] file path of robot.txt
+/// @return the five parameters
+/// @throws posefuse::io_error (file:line) for a missing file, an unknown or
+///         duplicate key, a line that is not `key value`, a bad, non-finite or
+///         non-positive value, alpha outside (0, 1), or a missing key
+[[nodiscard]] inline RobotLogParams read_robot_params(const std::filesystem::path& file) {
+  RobotLogParams p;
+  struct Key {
+    std::string_view name;
+    double* value;
+    std::size_t line;
+  };
+  std::array<Key, 5> keys{{{"ticks_per_rev", &p.ticks_per_rev, 0},
+                           {"wheel_radius_m", &p.wheel_radius_m, 0},
+                           {"track_width_m", &p.track_width_m, 0},
+                           {"complementary_alpha", &p.complementary_alpha, 0},
+                           {"fuser_threshold", &p.fuser_threshold, 0}}};
+  for (const auto& [n, full] : detail::read_content_lines(file)) {
+    std::string_view text = full;
+    if (const std::size_t h = text.find('#'); h != std::string_view::npos)
+      text = detail::trim(text.substr(0, h));
+    const std::size_t sp = text.find_first_of(" \t=");
+    if (sp == std::string_view::npos)
+      throw io_error(file, n, "expected 'key value', got '" + std::string(text) + "'");
+    const std::string key = detail::lower(detail::trim(text.substr(0, sp)));
+    std::string_view val = detail::trim(text.substr(sp + 1));
+    if (!val.empty() && val.front() == '=') val = detail::trim(val.substr(1));
+    Key* k = nullptr;
+    for (Key& c : keys) {
+      if (c.name == key) k = &c;
+    }
+    if (k == nullptr)
+      throw io_error(file, n, "unknown key '" + key +
+                                  "' (expected ticks_per_rev, wheel_radius_m, track_width_m, "
+                                  "complementary_alpha, fuser_threshold)");
+    if (k->line != 0)
+      throw io_error(file, n, "duplicate key '" + key + "' (first on line " +
+                                  std::to_string(k->line) + ")");
+    double v = 0;
+    const auto [ptr, ec] = std::from_chars(val.data(), val.data() + val.size(), v);
+    if (val.empty() || ec != std::errc{} || ptr != val.data() + val.size())
+      throw io_error(file, n, "value of '" + key + "' is not a number ('" + std::string(val) + "')");
+    if (!std::isfinite(v) || v <= 0)
+      throw io_error(file, n, "value of '" + key + "' must be positive and finite, got " +
+                                  std::string(val));
+    if (key == "complementary_alpha" && v >= 1)
+      throw io_error(file, n, "complementary_alpha must lie in (0, 1), got " + std::string(val));
+    *k->value = v;
+    k->line = n;
+  }
+  for (const Key& k : keys) {
+    if (k.line == 0) throw io_error(file, "missing required key '" + std::string(k.name) + "'");
+  }
+  return p;
+}
+
+/// Reads a log folder (see the file comment for the format).
+/// @param[in] dir the folder holding wheels.csv, imu.csv, slam.csv, robot.txt
+///            and optionally groundtruth.csv
+/// @return the log, rows in file order
+/// @throws posefuse::io_error naming file and line for anything malformed;
+///         also when wheels.csv has fewer than two rows or imu.csv none
+[[nodiscard]] inline RobotLog read_robot_log(const std::filesystem::path& dir) {
+  using detail::CsvLine;
+  if (!std::filesystem::is_directory(dir)) throw io_error(dir, "log folder does not exist");
+  RobotLog log;
+  log.params = read_robot_params(dir / "robot.txt");
+  const auto wheels_file = dir / "wheels.csv";
+  log.wheels = detail::read_csv<WheelRecord>(wheels_file, detail::kWheelCols, [](CsvLine& c) {
+    WheelRecord r;
+    r.t_ns = c.integer();
+    r.fl = c.integer();
+    r.fr = c.integer();
+    r.bl = c.integer();
+    r.br = c.integer();
+    return r;
+  });
+  if (log.wheels.size() < 2) throw io_error(wheels_file, "needs at least two data rows");
+  const auto imu_file = dir / "imu.csv";
+  log.imu = detail::read_csv<ImuRecord>(imu_file, detail::kImuCols, [](CsvLine& c) {
+    ImuRecord r;
+    r.t_ns = c.integer();
+    for (double& v : r.accel_mps2) v = c.real();
+    for (double& v : r.gyro_radps) v = c.real();
+    for (double& v : r.mag_uT) v = c.real();
+    return r;
+  });
+  if (log.imu.empty()) throw io_error(imu_file, "has no data rows");
+  const auto slam_file = dir / "slam.csv";
+  log.slam = detail::read_csv<SlamRecord>(slam_file, detail::kSlamCols, [](CsvLine& c) {
+    SlamRecord r;
+    r.t_ns = c.integer();
+    const std::string_view s = c.text();
+    const std::string st = detail::lower(s);
+    if (st == "tracking") r.state = SlamState::kTracking;
+    else if (st == "lost") r.state = SlamState::kLost;
+    else if (st == "reinit") r.state = SlamState::kReinit;
+    else c.fail("tracking, lost or reinit", s);
+    const bool lost = r.state == SlamState::kLost;
+    for (double& v : r.p) v = c.real(lost);
+    for (double& v : r.q) v = c.real(lost);
+    if (!lost) {
+      const double n2 = r.q[0] * r.q[0] + r.q[1] * r.q[1] + r.q[2] * r.q[2] + r.q[3] * r.q[3];
+      if (!(std::abs(std::sqrt(n2) - 1.0) < 1e-2))
+        c.error("quaternion (qx,qy,qz,qw) is not unit length (|q| = " +
+                detail::fmt(std::sqrt(n2)) + ")");
+    }
+    return r;
+  });
+  const auto gt_file = dir / "groundtruth.csv";
+  if (std::filesystem::exists(gt_file)) {
+    log.groundtruth =
+        detail::read_csv<GroundTruthRecord>(gt_file, detail::kTruthCols, [](CsvLine& c) {
+          GroundTruthRecord r;
+          r.t_ns = c.integer();
+          r.x = c.real();
+          r.y = c.real();
+          r.yaw = c.real();
+          return r;
+        });
+  }
+  return log;
+}
+
+/// Writes a log folder in exactly the format read_robot_log reads (creating
+/// the folder). Numbers are written in the shortest form that reads back to
+/// the same double, so a written log reads back bit-identical.
+/// @param[in] dir destination folder (created if absent; files overwritten)
+/// @param[in] log the log; groundtruth.csv is written only when non-empty
+/// @throws posefuse::io_error when a file cannot be written
+inline void write_robot_log(const std::filesystem::path& dir, const RobotLog& log) {
+  using detail::fmt;
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw io_error(dir, "cannot create folder: " + ec.message());
+  const auto write = [&dir](const char* name, const char* header, auto&& body) {
+    auto out = detail::open_for_writing(dir / name);
+    out << header;
+    body(out);
+    if (!out.flush()) throw io_error(dir / name, "write failed");
+  };
+  const auto& P = log.params;
+  write("robot.txt", "# posefuse robot log parameters (key value)\n", [&](std::ostream& o) {
+    o << "ticks_per_rev " << fmt(P.ticks_per_rev) << "\nwheel_radius_m " << fmt(P.wheel_radius_m)
+      << "\ntrack_width_m " << fmt(P.track_width_m) << "\ncomplementary_alpha "
+      << fmt(P.complementary_alpha) << "\nfuser_threshold " << fmt(P.fuser_threshold) << "\n";
+  });
+  write("wheels.csv", "# t_ns,fl,fr,bl,br\n", [&](std::ostream& o) {
+    for (const auto& r : log.wheels)
+      o << r.t_ns << ',' << r.fl << ',' << r.fr << ',' << r.bl << ',' << r.br << '\n';
+  });
+  write("imu.csv", "# t_ns,ax,ay,az,gx,gy,gz,mx,my,mz\n", [&](std::ostream& o) {
+    for (const auto& r : log.imu) {
+      o << r.t_ns;
+      for (const auto* a : {&r.accel_mps2, &r.gyro_radps, &r.mag_uT})
+        for (double v : *a) o << ',' << fmt(v);
+      o << '\n';
+    }
+  });
+  write("slam.csv", "# t_ns,state,x,y,z,qx,qy,qz,qw\n", [&](std::ostream& o) {
+    for (const auto& r : log.slam) {
+      o << r.t_ns << ',' << to_string(r.state);
+      for (double v : r.p) o << ',' << fmt(v);
+      for (double v : r.q) o << ',' << fmt(v);
+      o << '\n';
+    }
+  });
+  if (log.groundtruth.empty()) {
+    std::filesystem::remove(dir / "groundtruth.csv", ec);  // no stale ground truth
+    return;
+  }
+  write("groundtruth.csv", "# t_ns,x,y,yaw\n", [&](std::ostream& o) {
+    for (const auto& r : log.groundtruth)
+      o << r.t_ns << ',' << fmt(r.x) << ',' << fmt(r.y) << ',' << fmt(r.yaw) << '\n';
+  });
+}
+
+}  // namespace posefuse
