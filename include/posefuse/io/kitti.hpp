@@ -1,0 +1,168 @@
+#pragma once
+/// @file
+/// KITTI odometry pose files (12 numbers a line) and their `times.txt`.
+///
+/// A KITTI pose line is the row-major 3x4 matrix \f$ [R \mid t] \f$ of
+/// \f$ T_{world,cam} \f$: `r11 r12 r13 tx r21 r22 r23 ty r31 r32 r33 tz`
+/// (Geiger et al., CVPR 2012, odometry devkit). `times.txt` holds one stamp
+/// (s) a line. Blank lines and lines starting with '#' are skipped; line
+/// numbers in errors are the file's physical, 1-based lines.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstddef>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <posefuse/core/error.hpp>
+#include <posefuse/io/detail/text.hpp>
+#include <posefuse/io/read_options.hpp>
+#include <posefuse/io/trajectory.hpp>
+
+namespace posefuse {
+
+namespace detail {
+
+/// Values read from a file together with the physical line of each.
+template <class T>
+struct NumberedRows {
+  std::vector<T> values;
+  std::vector<std::size_t> lines;
+};
+
+inline NumberedRows<Eigen::Isometry3d> read_kitti_rows(const std::filesystem::path& file,
+                                                      const ReadOptions& options) {
+  LineReader reader(file);
+  NumberedRows<Eigen::Isometry3d> rows;
+  std::string line;
+  while (reader.next(line)) {
+    if (is_blank_or_comment(line)) continue;
+    const std::vector<double> v =
+        parse_row(line, 12, "KITTI pose: row-major 3x4 [R|t]", file, reader.line_no());
+    Eigen::Matrix3d R;
+    R << v[0], v[1], v[2], v[4], v[5], v[6], v[8], v[9], v[10];
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = checked_rotation(R, options.rotation_tolerance, file, reader.line_no());
+    T.translation() = Eigen::Vector3d(v[3], v[7], v[11]);
+    rows.values.push_back(T);
+    rows.lines.push_back(reader.line_no());
+  }
+  return rows;
+}
+
+inline NumberedRows<double> read_stamp_rows(const std::filesystem::path& file) {
+  LineReader reader(file);
+  NumberedRows<double> rows;
+  std::string line;
+  while (reader.next(line)) {
+    if (is_blank_or_comment(line)) continue;
+    const double t = parse_row(line, 1, "one timestamp in seconds", file, reader.line_no())[0];
+    if (!rows.values.empty() && !(t > rows.values.back())) {
+      throw io_error(file, reader.line_no(),
+                     "timestamp " + format_number(t) + " is not greater than the previous one (" +
+                         format_number(rows.values.back()) + " on line " +
+                         std::to_string(rows.lines.back()) + ")");
+    }
+    rows.values.push_back(t);
+    rows.lines.push_back(reader.line_no());
+  }
+  return rows;
+}
+
+}  // namespace detail
+
+/// Reads a KITTI `times.txt`: one timestamp (s) a line, strictly increasing.
+/// @param[in] file path of the times file
+/// @return the stamps in file order
+/// @throws posefuse::io_error (file:line) when the file cannot be opened, a
+///         line has not exactly one number, a number is unparsable or not
+///         finite, or a stamp is not greater than the previous one
+[[nodiscard]] inline std::vector<double> read_kitti_times(const std::filesystem::path& file) {
+  return detail::read_stamp_rows(file).values;
+}
+
+/// Reads a KITTI pose file, optionally with its `times.txt`.
+///
+/// Rotations are checked against `options.rotation_tolerance` and
+/// re-orthonormalised (see ReadOptions). Without `times`, the stamps are
+/// the frame indices 0, 1, 2, ... (s), which is also what evo assumes when
+/// it treats a KITTI file as a path without timestamps.
+/// @param[in] poses_file path of the pose file
+/// @param[in] times_file optional path of the matching `times.txt`
+/// @param[in] options rotation tolerance
+/// @return the trajectory \f$ T_{world,cam} \f$
+/// @throws posefuse::io_error (file:line) when a file cannot be opened, a
+///         line has not 12 numbers (the message gives the count found), a
+///         number is unparsable or not finite, a rotation is not
+///         orthonormal within tolerance or is a reflection, a stamp does not
+///         increase, or the times file has a different number of entries
+///         (the error names the first line without a partner)
+[[nodiscard]] inline Trajectory read_kitti(const std::filesystem::path& poses_file,
+                                           const std::optional<std::filesystem::path>& times_file =
+                                               std::nullopt,
+                                           const ReadOptions& options = {}) {
+  detail::NumberedRows<Eigen::Isometry3d> rows = detail::read_kitti_rows(poses_file, options);
+  Trajectory traj;
+  traj.poses = std::move(rows.values);
+  if (!times_file) {
+    traj.stamps.resize(traj.poses.size());
+    for (std::size_t k = 0; k < traj.stamps.size(); ++k) traj.stamps[k] = static_cast<double>(k);
+    return traj;
+  }
+  detail::NumberedRows<double> stamps = detail::read_stamp_rows(*times_file);
+  const std::size_t n_poses = traj.poses.size();
+  const std::size_t n_stamps = stamps.values.size();
+  if (n_stamps > n_poses) {
+    throw io_error(*times_file, stamps.lines[n_poses],
+                   "times file has " + std::to_string(n_stamps) + " timestamps but " +
+                       poses_file.string() + " has " + std::to_string(n_poses) +
+                       " poses; this is the first timestamp without a pose");
+  }
+  if (n_stamps < n_poses) {
+    throw io_error(poses_file, rows.lines[n_stamps],
+                   "pose file has " + std::to_string(n_poses) + " poses but " +
+                       times_file->string() + " has " + std::to_string(n_stamps) +
+                       " timestamps; this is the first pose without a timestamp");
+  }
+  traj.stamps = std::move(stamps.values);
+  return traj;
+}
+
+/// Writes the poses of `traj` as a KITTI pose file (stamps are not written;
+/// see `write_kitti_times`). Numbers are the shortest text that reads back
+/// to the same double, so `read_kitti(write_kitti(traj))` is bit-exact.
+/// @param[in] file output path (overwritten)
+/// @param[in] traj the trajectory
+/// @throws posefuse::invalid_argument when `traj` fails `validate()`
+/// @throws posefuse::io_error when the file cannot be written
+inline void write_kitti(const std::filesystem::path& file, const Trajectory& traj) {
+  traj.validate();
+  std::ofstream out = detail::open_for_writing(file);
+  for (const Eigen::Isometry3d& T : traj.poses) {
+    const Eigen::Matrix<double, 3, 4> M = T.matrix().topRows<3>();
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 4; ++c) {
+        if (r + c > 0) out << ' ';
+        out << detail::format_number(M(r, c));
+      }
+    }
+    out << '\n';
+  }
+  detail::finish_writing(out, file);
+}
+
+/// Writes the stamps of `traj` as a KITTI `times.txt` (one stamp a line,
+/// shortest round-trip text).
+/// @throws posefuse::invalid_argument when `traj` fails `validate()`
+/// @throws posefuse::io_error when the file cannot be written
+inline void write_kitti_times(const std::filesystem::path& file, const Trajectory& traj) {
+  traj.validate();
+  std::ofstream out = detail::open_for_writing(file);
+  for (const double t : traj.stamps) out << detail::format_number(t) << '\n';
+  detail::finish_writing(out, file);
+}
+
+}  // namespace posefuse
