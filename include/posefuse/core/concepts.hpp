@@ -24,10 +24,20 @@
 
 namespace posefuse {
 
-/// How a type behaves as a manifold. The primary template forwards to the
-/// type's members `Scalar`, `Dim`, `plus(dx)` and `minus(y)`.
+/// How a type behaves as a manifold. The primary template is empty (not a
+/// manifold); the specialisations below cover types with members `Scalar`,
+/// `Dim`, `plus(dx)` and `minus(y)`, and fixed-size Eigen column vectors.
+/// Specialise it for a third-party type you cannot change.
 template <class S>
-struct ManifoldTraits {
+struct ManifoldTraits {};
+
+/// Types that say what they are through their members.
+template <class S>
+  requires requires {
+    typename S::Scalar;
+    { S::Dim } -> std::convertible_to<int>;
+  }
+struct ManifoldTraits<S> {
   using Scalar = typename S::Scalar;
   static constexpr int Dim = S::Dim;
   using Tangent = Eigen::Matrix<Scalar, Dim, 1>;
@@ -46,6 +56,35 @@ struct ManifoldTraits<Eigen::Matrix<T, N, 1, Options, MaxRows, MaxCols>> {
   static Type plus(const Type& x, const Tangent& dx) { return x + dx; }
   static Tangent minus(const Type& y, const Type& x) { return y - x; }
 };
+
+namespace detail {
+template <class T>
+inline constexpr bool is_eigen_v = std::is_base_of_v<Eigen::EigenBase<std::remove_cvref_t<T>>,
+                                                     std::remove_cvref_t<T>>;
+template <class From, class To>
+consteval bool returns_fit() {
+  if constexpr (is_eigen_v<To>) {
+    // Eigen converts between any sizes at compile time and asserts at run
+    // time; a model must return exactly the size it promises.
+    if constexpr (is_eigen_v<From>) {
+      using F = std::remove_cvref_t<From>;
+      using T = std::remove_cvref_t<To>;
+      return int(F::RowsAtCompileTime) == int(T::RowsAtCompileTime) &&
+             int(F::ColsAtCompileTime) == int(T::ColsAtCompileTime) &&
+             std::is_same_v<typename F::Scalar, typename T::Scalar>;
+    } else {
+      return false;
+    }
+  } else {
+    return std::is_convertible_v<From, To>;
+  }
+}
+}  // namespace detail
+
+/// `From` is usable where `To` is expected, with equal compile-time sizes and
+/// scalar when `To` is an Eigen matrix.
+template <class From, class To>
+concept ReturnsExactly = detail::returns_fit<From, To>();
 
 /// Scalar type of a manifold.
 template <class S>
@@ -96,9 +135,9 @@ concept MotionModel =
     requires { typename M::State; typename M::Control; } && State<typename M::State> &&
     requires(const M& m, const typename M::State& x, const typename M::Control& u,
              ScalarOf<typename M::State> dt) {
-      { m.predict(x, u, dt) } -> std::convertible_to<typename M::State>;
-      { m.jacobian(x, u, dt) } -> std::convertible_to<CovarianceOf<typename M::State>>;
-      { m.noise(x, u, dt) } -> std::convertible_to<CovarianceOf<typename M::State>>;
+      { m.predict(x, u, dt) } -> ReturnsExactly<typename M::State>;
+      { m.jacobian(x, u, dt) } -> ReturnsExactly<CovarianceOf<typename M::State>>;
+      { m.noise(x, u, dt) } -> ReturnsExactly<CovarianceOf<typename M::State>>;
     };
 
 /// Jacobian of a measurement model, \f$ J_{h,x} \f$.
@@ -114,9 +153,9 @@ concept MeasurementModel =
     Measurement<typename H::Measurement> &&
     std::same_as<ScalarOf<typename H::State>, ScalarOf<typename H::Measurement>> &&
     requires(const H& h, const typename H::State& x) {
-      { h.predict(x) } -> std::convertible_to<typename H::Measurement>;
-      { h.jacobian(x) } -> std::convertible_to<MeasurementJacobianOf<H>>;
-      { h.noise() } -> std::convertible_to<CovarianceOf<typename H::Measurement>>;
+      { h.predict(x) } -> ReturnsExactly<typename H::Measurement>;
+      { h.jacobian(x) } -> ReturnsExactly<MeasurementJacobianOf<H>>;
+      { h.noise() } -> ReturnsExactly<CovarianceOf<typename H::Measurement>>;
     };
 
 /// A measurement model of the state type S.
@@ -153,17 +192,17 @@ consteval bool check_motion_model() {
       using U = typename M::Control;
       using T = ScalarOf<S>;
       static_assert(requires(const M& m, const S& x, const U& u, T dt) {
-                      { m.predict(x, u, dt) } -> std::convertible_to<S>;
+                      { m.predict(x, u, dt) } -> ReturnsExactly<S>;
                     },
                     "posefuse: a motion model needs `State predict(const State&, const Control&, "
                     "Scalar dt) const`");
       static_assert(requires(const M& m, const S& x, const U& u, T dt) {
-                      { m.jacobian(x, u, dt) } -> std::convertible_to<CovarianceOf<S>>;
+                      { m.jacobian(x, u, dt) } -> ReturnsExactly<CovarianceOf<S>>;
                     },
                     "posefuse: a motion model needs `Matrix<Scalar, Dim, Dim> jacobian(const "
                     "State&, const Control&, Scalar dt) const` (J_f_x)");
       static_assert(requires(const M& m, const S& x, const U& u, T dt) {
-                      { m.noise(x, u, dt) } -> std::convertible_to<CovarianceOf<S>>;
+                      { m.noise(x, u, dt) } -> ReturnsExactly<CovarianceOf<S>>;
                     },
                     "posefuse: a motion model needs `Matrix<Scalar, Dim, Dim> noise(const State&, "
                     "const Control&, Scalar dt) const` (process noise)");
@@ -193,17 +232,17 @@ consteval bool check_measurement_model() {
       static_assert(std::same_as<ScalarOf<S>, ScalarOf<Z>>,
                     "posefuse: State and Measurement of a measurement model must share a Scalar");
       static_assert(requires(const H& h, const S& x) {
-                      { h.predict(x) } -> std::convertible_to<Z>;
+                      { h.predict(x) } -> ReturnsExactly<Z>;
                     },
                     "posefuse: a measurement model needs `Measurement predict(const State&) const` "
                     "(h(x))");
       static_assert(requires(const H& h, const S& x) {
-                      { h.jacobian(x) } -> std::convertible_to<MeasurementJacobianOf<H>>;
+                      { h.jacobian(x) } -> ReturnsExactly<MeasurementJacobianOf<H>>;
                     },
                     "posefuse: a measurement model needs `Matrix<Scalar, Measurement::Dim, "
                     "State::Dim> jacobian(const State&) const` (J_h_x)");
       static_assert(requires(const H& h) {
-                      { h.noise() } -> std::convertible_to<CovarianceOf<Z>>;
+                      { h.noise() } -> ReturnsExactly<CovarianceOf<Z>>;
                     },
                     "posefuse: a measurement model needs `Matrix<Scalar, Measurement::Dim, "
                     "Measurement::Dim> noise() const`");

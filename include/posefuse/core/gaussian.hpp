@@ -20,8 +20,10 @@ template <class Derived>
 
 /// True when a square matrix is symmetric to a relative tolerance.
 template <class Derived>
-[[nodiscard]] bool is_symmetric(const Eigen::MatrixBase<Derived>& m,
-                                typename Derived::Scalar rel_tol = 1e-9) {
+[[nodiscard]] bool is_symmetric(
+    const Eigen::MatrixBase<Derived>& m,
+    typename Derived::Scalar rel_tol = typename Derived::Scalar(1e4) *
+                                       std::numeric_limits<typename Derived::Scalar>::epsilon()) {
   using T = typename Derived::Scalar;
   const T scale = std::max(T(1), m.cwiseAbs().maxCoeff());
   return ((m - m.transpose()).cwiseAbs().maxCoeff()) <= rel_tol * scale;

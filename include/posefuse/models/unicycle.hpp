@@ -1,0 +1,136 @@
+#pragma once
+/// @file
+/// Unicycle (differential-drive) motion on the plane, seed 001 eq 10, with
+/// analytic Jacobians, and a posefuse::MotionModel built on it.
+///
+/// The step is written in the displacements \f$ \Delta s = v\Delta t \f$ and
+/// \f$ \Delta\theta = w\Delta t \f$. Two integrators:
+///  * Integration::kEuler — eq 10 as printed:
+///    \f$ x' = x + \Delta s\cos\theta,\; y' = y + \Delta s\sin\theta,\;
+///        \theta' = \theta + \Delta\theta \f$.
+///  * Integration::kExactArc — the exact solution for constant v, w over the
+///    step (a circular arc), in chord form, smooth through \f$ \Delta\theta = 0 \f$:
+///    \f$ x' = x + \Delta s\,\mathrm{sinc}(\Delta\theta/2)\cos(\theta + \Delta\theta/2) \f$,
+///    \f$ y' = y + \Delta s\,\mathrm{sinc}(\Delta\theta/2)\sin(\theta + \Delta\theta/2) \f$,
+///    \f$ \theta' = \theta + \Delta\theta \f$.
+/// World frame x, y (m), heading counter-clockwise from x (rad), REP-103.
+
+#include <Eigen/Core>
+#include <cmath>
+#include <concepts>
+#include <cstdint>
+#include <limits>
+#include <posefuse/core/angles.hpp>
+#include <posefuse/core/concepts.hpp>
+#include <posefuse/models/planar_pose.hpp>
+
+namespace posefuse {
+
+/// How a unicycle step is integrated.
+enum class Integration : std::uint8_t {
+  kEuler,     ///< seed 001 eq 10 as printed (first order; drifts on curves)
+  kExactArc,  ///< exact for constant v and w over the step
+};
+
+namespace detail {
+/// \f$ \mathrm{sinc}(a) = \sin a / a \f$ and its derivative, series below eps^(1/8).
+template <std::floating_point T>
+inline void sinc_and_derivative(T a, T& s, T& ds) noexcept {
+  const T thr = std::sqrt(std::sqrt(std::sqrt(std::numeric_limits<T>::epsilon())));
+  const T a2 = a * a;
+  if (std::abs(a) < thr) {
+    s = T(1) - a2 / T(6) + a2 * a2 / T(120);
+    ds = a * (T(-1) / T(3) + a2 / T(30) - a2 * a2 / T(840));
+  } else {
+    s = std::sin(a) / a;
+    ds = (a * std::cos(a) - std::sin(a)) / a2;
+  }
+}
+}  // namespace detail
+
+/// One unicycle step (seed 001 eq 10, or the exact arc).
+/// @param[in] x pose before the step (m, m, rad)
+/// @param[in] ds_m arc length \f$ v\Delta t \f$, m
+/// @param[in] dtheta_rad heading change \f$ w\Delta t \f$, rad
+/// @param[in] method kEuler (eq 10) or kExactArc
+/// @param[out] J_x if not null, \f$ \partial x' / \partial x \f$ (3x3)
+/// @param[out] J_u if not null, \f$ \partial x' / \partial(\Delta s, \Delta\theta) \f$ (3x2)
+/// @return pose after the step, heading wrapped to [-pi, pi)
+template <std::floating_point T>
+[[nodiscard]] inline PlanarPose<T> unicycle_step(const PlanarPose<T>& x, T ds_m, T dtheta_rad,
+                                                 Integration method,
+                                                 Eigen::Matrix<T, 3, 3>* J_x = nullptr,
+                                                 Eigen::Matrix<T, 3, 2>* J_u = nullptr) noexcept {
+  PlanarPose<T> out;
+  out.theta = wrap_angle(x.theta + dtheta_rad);
+  if (method == Integration::kEuler) {
+    const T c = std::cos(x.theta), s = std::sin(x.theta);
+    out.x = x.x + ds_m * c;  // eq 10-b
+    out.y = x.y + ds_m * s;  // eq 10-c
+    if (J_x) *J_x << T(1), T(0), -ds_m * s, T(0), T(1), ds_m * c, T(0), T(0), T(1);
+    if (J_u) *J_u << c, T(0), s, T(0), T(0), T(1);
+    return out;
+  }
+  T k, dk;
+  detail::sinc_and_derivative(dtheta_rad / T(2), k, dk);
+  const T mid = x.theta + dtheta_rad / T(2);
+  const T c = std::cos(mid), s = std::sin(mid);
+  out.x = x.x + ds_m * k * c;
+  out.y = x.y + ds_m * k * s;
+  if (J_x) *J_x << T(1), T(0), -ds_m * k * s, T(0), T(1), ds_m * k * c, T(0), T(0), T(1);
+  if (J_u)
+    *J_u << k * c, ds_m * (dk * c - k * s) / T(2),  //
+        k * s, ds_m * (dk * s + k * c) / T(2),      //
+        T(0), T(1);
+  return out;
+}
+
+/// First-order covariance propagation through a step,
+/// \f$ P' = J_x P J_x^\top + J_u \Sigma_u J_u^\top \f$, symmetrised.
+/// @param[in] P pose covariance before the step
+/// @param[in] J_x, J_u Jacobians from unicycle_step
+/// @param[in] Sigma_u covariance of \f$ (\Delta s, \Delta\theta) \f$
+template <std::floating_point T>
+[[nodiscard]] inline Eigen::Matrix<T, 3, 3> propagate_pose_covariance(
+    const Eigen::Matrix<T, 3, 3>& P, const Eigen::Matrix<T, 3, 3>& J_x,
+    const Eigen::Matrix<T, 3, 2>& J_u, const Eigen::Matrix<T, 2, 2>& Sigma_u) noexcept {
+  const Eigen::Matrix<T, 3, 3> Pn = J_x * P * J_x.transpose() + J_u * Sigma_u * J_u.transpose();
+  return T(0.5) * (Pn + Pn.transpose());
+}
+
+/// Unicycle motion model driven by body velocities (a posefuse::MotionModel).
+/// State PlanarPose<T> (m, m, rad); Control (v m/s, w rad/s);
+/// \f$ f(x, u, \Delta t) \f$ = unicycle_step(x, v Δt, w Δt, method).
+template <std::floating_point T = double>
+struct Unicycle {
+  using Scalar = T;
+  using State = PlanarPose<T>;
+  using Control = Eigen::Matrix<T, 2, 1>;  ///< (v m/s, w rad/s)
+
+  Integration method{Integration::kExactArc};  ///< eq 10 (kEuler) or exact arc
+  /// Covariance of the control (v, w) over a step: (m/s)², (rad/s)².
+  Eigen::Matrix<T, 2, 2> control_cov = Eigen::Matrix<T, 2, 2>::Zero();
+
+  /// \f$ f(x, u, \Delta t) \f$.
+  [[nodiscard]] State predict(const State& x, const Control& u, T dt_s) const noexcept {
+    return unicycle_step(x, u(0) * dt_s, u(1) * dt_s, method);
+  }
+  /// \f$ J_{f,x} \f$.
+  [[nodiscard]] Eigen::Matrix<T, 3, 3> jacobian(const State& x, const Control& u, T dt_s) const noexcept {
+    Eigen::Matrix<T, 3, 3> J;
+    (void)unicycle_step(x, u(0) * dt_s, u(1) * dt_s, method, &J);
+    return J;
+  }
+  /// Process noise \f$ J_u (\Delta t^2 \Sigma_{vw}) J_u^\top \f$ (J_u w.r.t. (Δs, Δθ)).
+  [[nodiscard]] Eigen::Matrix<T, 3, 3> noise(const State& x, const Control& u, T dt_s) const noexcept {
+    Eigen::Matrix<T, 3, 2> Ju;
+    (void)unicycle_step(x, u(0) * dt_s, u(1) * dt_s, method, nullptr, &Ju);
+    const Eigen::Matrix<T, 3, 3> Q = (dt_s * dt_s) * (Ju * control_cov * Ju.transpose());
+    return T(0.5) * (Q + Q.transpose());
+  }
+};
+
+static_assert(check_motion_model<Unicycle<double>>());
+static_assert(MotionModel<Unicycle<float>>);
+
+}  // namespace posefuse

@@ -1,0 +1,48 @@
+#include <catch2/catch.hpp>
+#include <posefuse/core/pipeline.hpp>
+#include <string>
+
+using namespace posefuse;
+
+namespace {
+struct Scale {
+  using Input = double;
+  using Output = double;
+  double k = 2;
+  double operator()(double x) const { return k * x; }
+};
+struct Accumulate {  // keeps state between samples
+  using Input = double;
+  using Output = double;
+  double sum = 0;
+  double operator()(double x) { return sum += x; }
+};
+struct ToText {
+  using Input = double;
+  using Output = std::string;
+  std::string operator()(double x) const { return std::to_string(int(x)); }
+};
+struct NotAStage {};
+}  // namespace
+
+static_assert(Stage<Scale>);
+static_assert(!Stage<NotAStage>);
+static_assert(!Stage<int>);
+static_assert(std::is_same_v<decltype(make_pipeline(Scale{}, ToText{}))::Output, std::string>);
+static_assert(Stage<decltype(make_pipeline(Scale{}, Accumulate{}))>);
+
+TEST_CASE("Pipeline: stages run in order and keep their state", "[core][pipeline]") {
+  auto p = make_pipeline(Scale{3}, Accumulate{}, ToText{});
+  CHECK(p(1) == "3");
+  CHECK(p(2) == "9");
+  CHECK(p.stage<1>().sum == 9);
+  p.stage<0>().k = 1;
+  CHECK(p(1) == "10");
+}
+
+TEST_CASE("Pipeline: nested pipelines flatten and operator| composes", "[core][pipeline]") {
+  auto inner = make_pipeline(Scale{2}, Scale{5});
+  auto outer = inner | ToText{};
+  static_assert(decltype(outer)::size == 3);
+  CHECK(outer(1.5) == "15");
+}
