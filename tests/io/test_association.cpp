@@ -98,8 +98,7 @@ TEST_CASE("Association: the offset shifts the estimate either way", "[io][associ
 TEST_CASE("Association: nothing matched and bad input are errors", "[io][association]") {
   const std::vector<double> ref{0.0, 1.0};
   const std::vector<double> est{5.0, 6.0};
-  CHECK_THROWS_WITH(posefuse::associate(ref, est),
-                    Catch::Contains("found no matching timestamps"));
+  CHECK_THROWS_WITH(posefuse::associate(ref, est), Catch::Contains("found no matching timestamps"));
   CHECK_THROWS_AS(posefuse::associate(ref, std::vector<double>{}), posefuse::invalid_argument);
   CHECK_THROWS_AS(posefuse::associate(ref, ref, -0.1), posefuse::invalid_argument);
   const std::vector<double> unsorted{1.0, 0.0};
@@ -131,8 +130,7 @@ TEST_CASE("Association: binary search equals evo's linear scan on random stamps"
     const double max_diff = 0.002 + 0.01 * (trial % 4);
     const posefuse::Association expected = brute_force(ref, est, max_diff, offset);
     if (expected.size() == 0) {
-      CHECK_THROWS_AS(posefuse::associate(ref, est, max_diff, offset),
-                      posefuse::invalid_argument);
+      CHECK_THROWS_AS(posefuse::associate(ref, est, max_diff, offset), posefuse::invalid_argument);
       continue;
     }
     const posefuse::Association got = posefuse::associate(ref, est, max_diff, offset);

@@ -100,9 +100,8 @@ TEST_CASE("Formats: TUM round trip is bit-exact in stamps and positions", "[io][
 TEST_CASE("Formats: TUM reader skips comments, blank lines and CRLF", "[io][tum]") {
   TempDir dir("tum-ok");
   const double c = std::cos(0.25), s = std::sin(0.25);  // 0.5 rad about z
-  const std::string text = "# stamp x y z qx qy qz qw\r\n\r\n  1.0 1 2 3 0 0 " +
-                           std::to_string(s) + " " + std::to_string(c) +
-                           "\r\n\t2.5\t4 5 6  0 0 0 1.00001\r\n";
+  const std::string text = "# stamp x y z qx qy qz qw\r\n\r\n  1.0 1 2 3 0 0 " + std::to_string(s) +
+                           " " + std::to_string(c) + "\r\n\t2.5\t4 5 6  0 0 0 1.00001\r\n";
   const posefuse::Trajectory traj = posefuse::read_tum(dir.write("a.tum", text));
   REQUIRE(traj.size() == 2);
   CHECK(traj.stamps[1] == 2.5);
@@ -169,7 +168,8 @@ TEST_CASE("Formats: KITTI malformed lines report file:line and the reason", "[io
   for (const Case& c : cases) {
     SECTION(c.name) {
       // Two good lines, a comment and a blank line before the bad one: line 5.
-      const auto file = dir.write("poses.txt", kIdentityRow + "# comment\n\n" + kIdentityRow + c.line);
+      const auto file =
+          dir.write("poses.txt", kIdentityRow + "# comment\n\n" + kIdentityRow + c.line);
       check_error(expect_io_error([&] { (void)posefuse::read_kitti(file); }), file, 5, c.reason);
     }
   }
@@ -219,11 +219,13 @@ TEST_CASE("Formats: TUM malformed lines report file:line and the reason", "[io][
     const char* reason;
   };
   const Case cases[] = {
-      {"seven columns", "0.2 1 0 0 0 0 1\n", "expected 8 whitespace-separated numbers (TUM: t tx ty tz qx qy qz qw), found 7"},
+      {"seven columns", "0.2 1 0 0 0 0 1\n",
+       "expected 8 whitespace-separated numbers (TUM: t tx ty tz qx qy qz qw), found 7"},
       {"csv", "0.2,1,0,0,0,0,0,1\n", "found 1"},
       {"bad number", "0.2 1 0 0 0 0 0 one\n", "cannot parse 'one' in column 8"},
       {"nan stamp", "nan 1 0 0 0 0 0 1\n", "non-finite value 'nan' in column 1"},
-      {"equal stamp", "0.1 1 0 0 0 0 0 1\n", "timestamp 0.1 is not greater than the previous one (0.1 on line 3)"},
+      {"equal stamp", "0.1 1 0 0 0 0 0 1\n",
+       "timestamp 0.1 is not greater than the previous one (0.1 on line 3)"},
       {"earlier stamp", "0.05 1 0 0 0 0 0 1\n", "not greater than the previous"},
       {"zero quaternion", "0.2 1 0 0 0 0 0 0\n", "quaternion has zero norm"},
       {"non-unit quaternion", "0.2 1 0 0 0 0 0 2\n", "quaternion norm 2 differs from 1"},

@@ -19,8 +19,8 @@ class TempDir {
     static std::atomic<unsigned> counter{0};
     const auto ticks = std::chrono::steady_clock::now().time_since_epoch().count();
     path_ = std::filesystem::temp_directory_path() /
-            (std::string(tag) + "-" + std::to_string(::getpid()) + "-" +
-             std::to_string(counter++) + "-" + std::to_string(ticks));
+            (std::string(tag) + "-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) +
+             "-" + std::to_string(ticks));
     std::filesystem::create_directories(path_);
   }
   TempDir(const TempDir&) = delete;

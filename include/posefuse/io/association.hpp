@@ -41,15 +41,14 @@ struct AssociatedTrajectories {
   Trajectory est;  ///< estimate at the matched indices
 };
 
-namespace detail {
+namespace detail::traj_io {
 
 /// evo's `matching_time_indices(short, long, max_diff, offset)` on sorted
 /// `long` stamps: for each short stamp, the first argmin of
 /// |(long + offset) - short|, kept when <= max_diff. Binary search replaces
 /// numpy's linear scan; ties resolve to the first index as np.argmin does.
-inline void match_nearest(std::span<const double> short_stamps,
-                          std::span<const double> long_stamps, double max_diff, double offset,
-                          std::vector<std::size_t>& short_ids,
+inline void match_nearest(std::span<const double> short_stamps, std::span<const double> long_stamps,
+                          double max_diff, double offset, std::vector<std::size_t>& short_ids,
                           std::vector<std::size_t>& long_ids) {
   std::vector<double> shifted(long_stamps.begin(), long_stamps.end());
   for (double& t : shifted) t += offset;  // rounding keeps the order (may create equal values)
@@ -84,13 +83,12 @@ inline void check_stamps(std::span<const double> stamps, const char* which) {
   for (std::size_t k = 0; k < stamps.size(); ++k) {
     if (!std::isfinite(stamps[k]) || (k > 0 && stamps[k] < stamps[k - 1])) {
       throw invalid_argument(std::string("associate: ") + which +
-                             " stamps must be finite and sorted (index " + std::to_string(k) +
-                             ")");
+                             " stamps must be finite and sorted (index " + std::to_string(k) + ")");
     }
   }
 }
 
-}  // namespace detail
+}  // namespace detail::traj_io
 
 /// Associates two stamp sequences as evo's `associate_trajectories`
 /// (see the file comment for the rule).
@@ -107,27 +105,28 @@ inline void check_stamps(std::span<const double> stamps, const char* which) {
                                            double max_diff_s = 0.01, double offset_est_s = 0.0) {
   if (!(max_diff_s >= 0.0) || !std::isfinite(max_diff_s)) {
     throw invalid_argument("associate: max time difference must be finite and >= 0, got " +
-                           detail::format_number(max_diff_s));
+                           detail::traj_io::format_number(max_diff_s));
   }
   if (!std::isfinite(offset_est_s)) {
     throw invalid_argument("associate: time offset must be finite");
   }
-  detail::check_stamps(ref_stamps, "reference");
-  detail::check_stamps(est_stamps, "estimate");
+  detail::traj_io::check_stamps(ref_stamps, "reference");
+  detail::traj_io::check_stamps(est_stamps, "estimate");
   Association a;
   const bool est_longer = est_stamps.size() > ref_stamps.size();
   if (est_longer) {
-    detail::match_nearest(ref_stamps, est_stamps, max_diff_s, offset_est_s, a.ref_ids, a.est_ids);
+    detail::traj_io::match_nearest(ref_stamps, est_stamps, max_diff_s, offset_est_s, a.ref_ids,
+                                   a.est_ids);
   } else {
-    detail::match_nearest(est_stamps, ref_stamps, max_diff_s, -offset_est_s, a.est_ids,
-                          a.ref_ids);
+    detail::traj_io::match_nearest(est_stamps, ref_stamps, max_diff_s, -offset_est_s, a.est_ids,
+                                   a.ref_ids);
   }
   if (a.size() == 0) {
     throw invalid_argument("associate: found no matching timestamps between the reference (" +
                            std::to_string(ref_stamps.size()) + " stamps) and the estimate (" +
                            std::to_string(est_stamps.size()) + " stamps) with max. time diff " +
-                           detail::format_number(max_diff_s) + " s and time offset " +
-                           detail::format_number(offset_est_s) + " s");
+                           detail::traj_io::format_number(max_diff_s) + " s and time offset " +
+                           detail::traj_io::format_number(offset_est_s) + " s");
   }
   return a;
 }

@@ -24,7 +24,7 @@
 
 namespace posefuse {
 
-namespace detail {
+namespace detail::traj_io {
 
 /// Values read from a file together with the physical line of each.
 template <class T>
@@ -34,7 +34,7 @@ struct NumberedRows {
 };
 
 inline NumberedRows<Eigen::Isometry3d> read_kitti_rows(const std::filesystem::path& file,
-                                                      const ReadOptions& options) {
+                                                       const ReadOptions& options) {
   LineReader reader(file);
   NumberedRows<Eigen::Isometry3d> rows;
   std::string line;
@@ -72,7 +72,7 @@ inline NumberedRows<double> read_stamp_rows(const std::filesystem::path& file) {
   return rows;
 }
 
-}  // namespace detail
+}  // namespace detail::traj_io
 
 /// Reads a KITTI `times.txt`: one timestamp (s) a line, strictly increasing.
 /// @param[in] file path of the times file
@@ -81,7 +81,7 @@ inline NumberedRows<double> read_stamp_rows(const std::filesystem::path& file) {
 ///         line has not exactly one number, a number is unparsable or not
 ///         finite, or a stamp is not greater than the previous one
 [[nodiscard]] inline std::vector<double> read_kitti_times(const std::filesystem::path& file) {
-  return detail::read_stamp_rows(file).values;
+  return detail::traj_io::read_stamp_rows(file).values;
 }
 
 /// Reads a KITTI pose file, optionally with its `times.txt`.
@@ -100,11 +100,12 @@ inline NumberedRows<double> read_stamp_rows(const std::filesystem::path& file) {
 ///         orthonormal within tolerance or is a reflection, a stamp does not
 ///         increase, or the times file has a different number of entries
 ///         (the error names the first line without a partner)
-[[nodiscard]] inline Trajectory read_kitti(const std::filesystem::path& poses_file,
-                                           const std::optional<std::filesystem::path>& times_file =
-                                               std::nullopt,
-                                           const ReadOptions& options = {}) {
-  detail::NumberedRows<Eigen::Isometry3d> rows = detail::read_kitti_rows(poses_file, options);
+[[nodiscard]] inline Trajectory read_kitti(
+    const std::filesystem::path& poses_file,
+    const std::optional<std::filesystem::path>& times_file = std::nullopt,
+    const ReadOptions& options = {}) {
+  detail::traj_io::NumberedRows<Eigen::Isometry3d> rows =
+      detail::traj_io::read_kitti_rows(poses_file, options);
   Trajectory traj;
   traj.poses = std::move(rows.values);
   if (!times_file) {
@@ -112,7 +113,7 @@ inline NumberedRows<double> read_stamp_rows(const std::filesystem::path& file) {
     for (std::size_t k = 0; k < traj.stamps.size(); ++k) traj.stamps[k] = static_cast<double>(k);
     return traj;
   }
-  detail::NumberedRows<double> stamps = detail::read_stamp_rows(*times_file);
+  detail::traj_io::NumberedRows<double> stamps = detail::traj_io::read_stamp_rows(*times_file);
   const std::size_t n_poses = traj.poses.size();
   const std::size_t n_stamps = stamps.values.size();
   if (n_stamps > n_poses) {
@@ -140,18 +141,18 @@ inline NumberedRows<double> read_stamp_rows(const std::filesystem::path& file) {
 /// @throws posefuse::io_error when the file cannot be written
 inline void write_kitti(const std::filesystem::path& file, const Trajectory& traj) {
   traj.validate();
-  std::ofstream out = detail::open_for_writing(file);
+  std::ofstream out = detail::traj_io::open_output(file);
   for (const Eigen::Isometry3d& T : traj.poses) {
     const Eigen::Matrix<double, 3, 4> M = T.matrix().topRows<3>();
     for (int r = 0; r < 3; ++r) {
       for (int c = 0; c < 4; ++c) {
         if (r + c > 0) out << ' ';
-        out << detail::format_number(M(r, c));
+        out << detail::traj_io::format_number(M(r, c));
       }
     }
     out << '\n';
   }
-  detail::finish_writing(out, file);
+  detail::traj_io::finish_output(out, file);
 }
 
 /// Writes the stamps of `traj` as a KITTI `times.txt` (one stamp a line,
@@ -160,9 +161,9 @@ inline void write_kitti(const std::filesystem::path& file, const Trajectory& tra
 /// @throws posefuse::io_error when the file cannot be written
 inline void write_kitti_times(const std::filesystem::path& file, const Trajectory& traj) {
   traj.validate();
-  std::ofstream out = detail::open_for_writing(file);
-  for (const double t : traj.stamps) out << detail::format_number(t) << '\n';
-  detail::finish_writing(out, file);
+  std::ofstream out = detail::traj_io::open_output(file);
+  for (const double t : traj.stamps) out << detail::traj_io::format_number(t) << '\n';
+  detail::traj_io::finish_output(out, file);
 }
 
 }  // namespace posefuse

@@ -50,8 +50,8 @@ struct Trajectory {
   /// @throws posefuse::invalid_argument naming the first offending index
   void validate() const {
     if (stamps.size() != poses.size()) {
-      throw invalid_argument("trajectory has " + std::to_string(stamps.size()) +
-                             " stamps but " + std::to_string(poses.size()) + " poses");
+      throw invalid_argument("trajectory has " + std::to_string(stamps.size()) + " stamps but " +
+                             std::to_string(poses.size()) + " poses");
     }
     for (std::size_t k = 0; k < poses.size(); ++k) {
       if (!std::isfinite(stamps[k])) {

@@ -35,23 +35,24 @@ namespace posefuse {
 ///         far from unit norm, or a stamp is not greater than the previous
 [[nodiscard]] inline Trajectory read_tum(const std::filesystem::path& file,
                                          const ReadOptions& options = {}) {
-  detail::LineReader reader(file);
+  detail::traj_io::LineReader reader(file);
   Trajectory traj;
   std::size_t previous_line = 0;
   std::string line;
   while (reader.next(line)) {
-    if (detail::is_blank_or_comment(line)) continue;
+    if (detail::traj_io::is_blank_or_comment(line)) continue;
     const std::size_t n = reader.line_no();
-    const std::vector<double> v = detail::parse_row(line, 8, "TUM: t tx ty tz qx qy qz qw", file, n);
+    const std::vector<double> v =
+        detail::traj_io::parse_row(line, 8, "TUM: t tx ty tz qx qy qz qw", file, n);
     if (!traj.stamps.empty() && !(v[0] > traj.stamps.back())) {
       throw io_error(file, n,
-                     "timestamp " + detail::format_number(v[0]) +
+                     "timestamp " + detail::traj_io::format_number(v[0]) +
                          " is not greater than the previous one (" +
-                         detail::format_number(traj.stamps.back()) + " on line " +
+                         detail::traj_io::format_number(traj.stamps.back()) + " on line " +
                          std::to_string(previous_line) + ")");
     }
     // Eigen's constructor takes (w, x, y, z); the file stores x y z w.
-    const Eigen::Quaterniond q = detail::checked_quaternion(
+    const Eigen::Quaterniond q = detail::traj_io::checked_quaternion(
         Eigen::Quaterniond(v[7], v[4], v[5], v[6]), options.quaternion_norm_tolerance, file, n);
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
     T.linear() = q.toRotationMatrix();
@@ -72,7 +73,7 @@ namespace posefuse {
 /// @throws posefuse::io_error when the file cannot be written
 inline void write_tum(const std::filesystem::path& file, const Trajectory& traj) {
   traj.validate();
-  std::ofstream out = detail::open_for_writing(file);
+  std::ofstream out = detail::traj_io::open_output(file);
   out << "# timestamp tx ty tz qx qy qz qw\n";
   for (std::size_t k = 0; k < traj.size(); ++k) {
     const Eigen::Isometry3d& T = traj.poses[k];
@@ -80,13 +81,13 @@ inline void write_tum(const std::filesystem::path& file, const Trajectory& traj)
     q.normalize();
     if (q.w() < 0.0) q.coeffs() = -q.coeffs();
     const Eigen::Vector3d p = T.translation();
-    out << detail::format_number(traj.stamps[k]);
+    out << detail::traj_io::format_number(traj.stamps[k]);
     for (const double x : {p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), q.w()}) {
-      out << ' ' << detail::format_number(x);
+      out << ' ' << detail::traj_io::format_number(x);
     }
     out << '\n';
   }
-  detail::finish_writing(out, file);
+  detail::traj_io::finish_output(out, file);
 }
 
 }  // namespace posefuse

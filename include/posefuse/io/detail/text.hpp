@@ -20,7 +20,9 @@
 
 #include <posefuse/core/error.hpp>
 
-namespace posefuse::detail {
+/// Internals of the trajectory readers/writers; nested so that other io
+/// headers (e.g. robot_log.hpp) can keep their own detail helpers.
+namespace posefuse::detail::traj_io {
 
 /// Reads a text file line by line, counting 1-based line numbers and
 /// stripping a trailing '\r' (files written on Windows).
@@ -51,7 +53,7 @@ class LineReader {
 
 /// Opens `file` for writing (truncating it).
 /// @throws posefuse::io_error when it cannot be opened
-[[nodiscard]] inline std::ofstream open_for_writing(const std::filesystem::path& file) {
+[[nodiscard]] inline std::ofstream open_output(const std::filesystem::path& file) {
   std::ofstream out(file, std::ios::out | std::ios::trunc);
   if (!out) throw io_error(file, "cannot open file for writing");
   return out;
@@ -59,7 +61,7 @@ class LineReader {
 
 /// Flushes `out` and reports a failed write.
 /// @throws posefuse::io_error when any write to `file` failed
-inline void finish_writing(std::ofstream& out, const std::filesystem::path& file) {
+inline void finish_output(std::ofstream& out, const std::filesystem::path& file) {
   out.flush();
   if (!out) throw io_error(file, "write failed");
 }
@@ -109,13 +111,13 @@ inline void finish_writing(std::ofstream& out, const std::filesystem::path& file
   }
   if (ec != std::errc{} || ptr != end) {
     throw io_error(file, line,
-                   "cannot parse '" + std::string(token) + "' in column " +
-                       std::to_string(column) + " as a number");
+                   "cannot parse '" + std::string(token) + "' in column " + std::to_string(column) +
+                       " as a number");
   }
   if (!std::isfinite(value)) {
-    throw io_error(file, line,
-                   "non-finite value '" + std::string(token) + "' in column " +
-                       std::to_string(column));
+    throw io_error(
+        file, line,
+        "non-finite value '" + std::string(token) + "' in column " + std::to_string(column));
   }
   return value;
 }
@@ -159,8 +161,7 @@ inline constexpr double kExactlyOrthonormal = 1e-12;
 [[nodiscard]] inline Eigen::Matrix3d checked_rotation(const Eigen::Matrix3d& R, double tolerance,
                                                       const std::filesystem::path& file,
                                                       std::size_t line) {
-  const double residual =
-      (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  const double residual = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   if (!(residual <= tolerance)) {
     throw io_error(file, line,
                    "rotation is not orthonormal: max |R^T R - I| = " + format_number(residual) +
@@ -168,8 +169,7 @@ inline constexpr double kExactlyOrthonormal = 1e-12;
   }
   const double det = R.determinant();
   if (!(det > 0.0)) {
-    throw io_error(file, line,
-                   "rotation is a reflection (det R = " + format_number(det) + ")");
+    throw io_error(file, line, "rotation is a reflection (det R = " + format_number(det) + ")");
   }
   if (residual <= kExactlyOrthonormal) return R;
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(R, Eigen::ComputeFullU | Eigen::ComputeFullV);
@@ -192,4 +192,4 @@ inline constexpr double kExactlyOrthonormal = 1e-12;
   return q.normalized();
 }
 
-}  // namespace posefuse::detail
+}  // namespace posefuse::detail::traj_io
