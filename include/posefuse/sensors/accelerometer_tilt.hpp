@@ -1,0 +1,101 @@
+#pragma once
+/// @file
+/// Roll and pitch from the accelerometer's measurement of gravity (seed 001
+/// eq 1-2), and the IMU sample type of the attitude chain.
+///
+/// Two conventions are offered:
+///  * accelerometer_tilt() is eq 1-2 exactly as printed, in the seed's own IMU
+///    axes (its Fig. 1, an EBIMU-9DOFV3): \f$ \rho_a \f$ ("roll") is the
+///    elevation of the sensor's x axis above the horizontal plane and
+///    \f$ \phi_a \f$ ("pitch") that of its y axis. `atan` (not `atan2`) keeps
+///    both in [-90°, 90°].
+///  * accelerometer_tilt_rep103() is the REP-103 body frame (x forward, y
+///    left, z up) with the accelerometer reading specific force, i.e.
+///    \f$ a = R^\top (0, 0, +g) \f$ at rest (+9.81 m/s² on z when level).
+///    For \f$ R = R_z R_y(\mathrm{pitch}) R_x(\mathrm{roll}) \f$ this gives
+///    \f$ a = g(-\sin p, \cos p \sin r, \cos p \cos r) \f$, hence
+///    roll = atan2(ay, az), pitch = atan2(-ax, sqrt(ay² + az²)).
+///    Roll covers (-180°, 180°], pitch [-90°, 90°].
+///
+/// In REP-103 axes the seed's angles are \f$ \rho_a = -\mathrm{pitch} \f$ and
+/// \f$ \phi_a = \arcsin(\cos p \sin r) \f$ (= roll only when pitch = 0); the
+/// attitude chain (sensors/pipelines.hpp) therefore uses the REP-103 form.
+
+#include <Eigen/Core>
+#include <cmath>
+#include <concepts>
+#include <posefuse/sensors/sample_status.hpp>
+
+namespace posefuse {
+
+/// Roll and pitch (rad). For the REP-103 functions these are the ZYX Euler
+/// roll (about body x) and pitch (about body y) of core/rotation.hpp; for the
+/// seed's eq 1-2 they are \f$ \rho_a \f$ and \f$ \phi_a \f$.
+template <std::floating_point T = double>
+struct Tilt {
+  T roll{0};   ///< rad
+  T pitch{0};  ///< rad
+};
+
+/// Seed 001 eq 1-2, as printed, in the seed's IMU axes:
+/// \f$ \rho_a = \arctan(A_x / \sqrt{A_y^2 + A_z^2}) \f$,
+/// \f$ \phi_a = \arctan(A_y / \sqrt{A_x^2 + A_z^2}) \f$.
+/// @param[in] a accelerometer reading (any unit; only its direction matters)
+/// @return {roll = rho_a, pitch = phi_a} in rad, each in [-pi/2, pi/2]; NaN
+///         components when a is zero or not finite
+template <std::floating_point T>
+[[nodiscard]] inline Tilt<T> accelerometer_tilt(const Eigen::Matrix<T, 3, 1>& a) noexcept {
+  return {std::atan(a.x() / std::sqrt(a.y() * a.y() + a.z() * a.z())),   // eq 1
+          std::atan(a.y() / std::sqrt(a.x() * a.x() + a.z() * a.z()))};  // eq 2
+}
+
+/// Roll and pitch from gravity in a REP-103 body frame (x forward, y left, z up),
+/// the accelerometer reading specific force (+g on z when level and at rest):
+/// \f$ \mathrm{roll} = \mathrm{atan2}(a_y, a_z) \f$,
+/// \f$ \mathrm{pitch} = \mathrm{atan2}(-a_x, \sqrt{a_y^2 + a_z^2}) \f$.
+/// Exact at rest; under linear acceleration the result is tilted toward the
+/// acceleration, which is why the complementary filter (eq 3-4) follows.
+/// @param[in] a specific force in the body frame (m/s², or any unit)
+/// @return ZYX roll in (-pi, pi] and pitch in [-pi/2, pi/2], rad; NaN components
+///         when a is not finite, and roll = pitch = 0 when a is zero
+template <std::floating_point T>
+[[nodiscard]] inline Tilt<T> accelerometer_tilt_rep103(const Eigen::Matrix<T, 3, 1>& a) noexcept {
+  return {std::atan2(a.y(), a.z()),
+          std::atan2(-a.x(), std::sqrt(a.y() * a.y() + a.z() * a.z()))};
+}
+
+/// One sample of a 9-axis IMU in the REP-103 body frame (x forward, y left, z up).
+struct ImuSample {
+  double t_s{0};                                       ///< time stamp, s (strictly increasing)
+  Eigen::Vector3d accel_mps2 = Eigen::Vector3d::Zero();  ///< specific force, m/s² (+9.81 on z at rest)
+  Eigen::Vector3d gyro_radps = Eigen::Vector3d::Zero();  ///< angular rate about x, y, z, rad/s
+  Eigen::Vector3d mag_uT = Eigen::Vector3d::Zero();      ///< magnetic field, µT
+};
+
+/// An IMU sample with a roll/pitch estimate attached (what flows between the
+/// stages of the attitude chain).
+struct TiltedImu {
+  ImuSample imu;                            ///< the raw sample
+  Tilt<double> tilt;                        ///< roll, pitch (rad), REP-103 ZYX
+  SampleStatus status{SampleStatus::kOk};  ///< kNonFinite when tilt is unusable
+};
+
+/// Attitude-chain stage 1: attaches the accelerometer's REP-103 tilt to each sample.
+/// Input ImuSample, Output TiltedImu (status kNonFinite when the accelerometer
+/// reading is not finite or zero).
+struct AccelerometerTiltStage {
+  using Input = ImuSample;
+  using Output = TiltedImu;
+
+  /// @param[in] s IMU sample (REP-103 body frame)
+  /// @return the sample with tilt = accelerometer_tilt_rep103(s.accel_mps2)
+  [[nodiscard]] TiltedImu operator()(const ImuSample& s) const noexcept {
+    TiltedImu out{s, accelerometer_tilt_rep103(s.accel_mps2), SampleStatus::kOk};
+    if (!s.accel_mps2.allFinite() || s.accel_mps2.squaredNorm() == 0.0) {
+      out.status = SampleStatus::kNonFinite;
+    }
+    return out;
+  }
+};
+
+}  // namespace posefuse

@@ -1,0 +1,95 @@
+#pragma once
+/// @file
+/// Dead reckoning of a planar pose from body motion (seed 001 eq 10), with the
+/// 3x3 pose covariance propagated from the per-step (Δs, Δθ) covariance that
+/// the wheel-odometry stages attach (itself from per-wheel encoder noise).
+
+#include <Eigen/Core>
+#include <cmath>
+#include <posefuse/core/error.hpp>
+#include <posefuse/core/gaussian.hpp>
+#include <posefuse/models/planar_pose.hpp>
+#include <posefuse/models/unicycle.hpp>
+#include <posefuse/sensors/sample_status.hpp>
+#include <posefuse/sensors/wheel_odometry.hpp>
+
+namespace posefuse {
+
+/// A planar pose (world frame, m, m, rad) with its covariance
+/// (order x, y, theta; m², m·rad, rad²). Output of the odometry chain.
+struct PoseWithCovariance {
+  PlanarPose<double> pose;                          ///< x, y, theta (theta in [-pi, pi))
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();    ///< covariance of (x, y, theta)
+  double t_s{0};                                    ///< time stamp of the pose, s
+  SampleStatus status{SampleStatus::kOk};           ///< kNonFinite: motion ignored, pose held
+};
+
+/// Odometry-chain stage 3: integrates BodyMotion into a pose (eq 10 or exact
+/// arc) and propagates \f$ P' = J_x P J_x^\top + J_u \Sigma_{\Delta s\Delta\theta} J_u^\top \f$.
+/// Input BodyMotion, Output PoseWithCovariance.
+class DeadReckoning {
+ public:
+  using Input = BodyMotion;
+  using Output = PoseWithCovariance;
+
+  /// @param[in] method kEuler (eq 10 as printed) or kExactArc
+  /// @param[in] start initial pose (world frame)
+  /// @param[in] cov0 initial covariance (symmetric PSD)
+  /// @throws posefuse::invalid_argument if start or cov0 is not finite, or cov0 not symmetric PSD
+  explicit DeadReckoning(Integration method = Integration::kExactArc,
+                         const PlanarPose<double>& start = {},
+                         const Eigen::Matrix3d& cov0 = Eigen::Matrix3d::Zero())
+      : method_(method) {
+    reset(start, cov0);
+  }
+
+  /// Re-anchors the integration (e.g. onto a fused or re-initialised pose).
+  /// @param[in] pose new pose (world frame); theta is wrapped
+  /// @param[in] cov its covariance (symmetric PSD)
+  /// @throws posefuse::invalid_argument if pose or cov is not finite, or cov not symmetric PSD
+  void reset(const PlanarPose<double>& pose, const Eigen::Matrix3d& cov) {
+    if (!std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.theta))
+      throw invalid_argument("posefuse: DeadReckoning pose must be finite");
+    if (!is_positive_semidefinite(cov))
+      throw invalid_argument("posefuse: DeadReckoning covariance must be finite, symmetric and PSD");
+    pose_ = {pose.x, pose.y, wrap_angle(pose.theta)};
+    cov_ = cov;
+  }
+
+  /// Integrates one step.
+  /// @param[in] ds_m arc length, m
+  /// @param[in] dtheta_rad heading change, rad
+  /// @param[in] cov_u covariance of (ds_m, dtheta_rad)
+  /// @return kOk, or kNonFinite (pose and covariance untouched)
+  [[nodiscard]] SampleStatus step(double ds_m, double dtheta_rad, const Eigen::Matrix2d& cov_u) noexcept {
+    if (!std::isfinite(ds_m) || !std::isfinite(dtheta_rad) || !cov_u.allFinite())
+      return SampleStatus::kNonFinite;
+    Eigen::Matrix3d J_x;
+    Eigen::Matrix<double, 3, 2> J_u;
+    pose_ = unicycle_step(pose_, ds_m, dtheta_rad, method_, &J_x, &J_u);
+    cov_ = propagate_pose_covariance(cov_, J_x, J_u, cov_u);
+    return SampleStatus::kOk;
+  }
+
+  /// Stage call: integrates `m.ds_m`, `m.dtheta_rad` with `m.cov`.
+  /// @return pose and covariance after the step, stamped m.t_s; status kNonFinite
+  ///         if the motion was not finite (pose held), else m.status
+  [[nodiscard]] PoseWithCovariance operator()(const BodyMotion& m) noexcept {
+    const SampleStatus st = step(m.ds_m, m.dtheta_rad, m.cov);
+    return {pose_, cov_, m.t_s, st == SampleStatus::kOk ? m.status : st};
+  }
+
+  /// Current pose.
+  [[nodiscard]] const PlanarPose<double>& pose() const noexcept { return pose_; }
+  /// Current covariance of (x, y, theta).
+  [[nodiscard]] const Eigen::Matrix3d& covariance() const noexcept { return cov_; }
+  /// The integrator in use.
+  [[nodiscard]] Integration method() const noexcept { return method_; }
+
+ private:
+  Integration method_;
+  PlanarPose<double> pose_;
+  Eigen::Matrix3d cov_ = Eigen::Matrix3d::Zero();
+};
+
+}  // namespace posefuse

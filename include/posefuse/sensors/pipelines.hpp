@@ -1,0 +1,132 @@
+#pragma once
+/// @file
+/// The two ready-made compile-time sensor chains of seed 001 (Fig. 2, Fig. 5):
+///
+///  * attitude: ImuSample -> AccelerometerTiltStage (eq 1-2, REP-103 form)
+///    -> ComplementaryTiltStage (eq 3-4) -> CompassStage (eq 5-7, corrected)
+///    -> Attitude;
+///  * odometry: StampedWheelTicks -> FourWheelAverage (eq 8)
+///    -> DiffDriveOdometry (eq 9) -> DeadReckoning (eq 10) -> PoseWithCovariance.
+///
+/// Both are posefuse::Pipeline types (core/pipeline.hpp): every call is
+/// inlined, no allocation, no virtual dispatch; stages are reachable with
+/// `pipeline.stage<I>()` (e.g. `stage<2>().reset(pose, cov)` to re-anchor
+/// dead reckoning).
+
+#include <Eigen/Core>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <posefuse/core/pipeline.hpp>
+#include <posefuse/filters/complementary.hpp>
+#include <posefuse/models/planar_pose.hpp>
+#include <posefuse/models/unicycle.hpp>
+#include <posefuse/sensors/accelerometer_tilt.hpp>
+#include <posefuse/sensors/compass.hpp>
+#include <posefuse/sensors/dead_reckoning.hpp>
+#include <posefuse/sensors/magnetometer_calibration.hpp>
+#include <posefuse/sensors/sample_status.hpp>
+#include <posefuse/sensors/wheel_odometry.hpp>
+
+namespace posefuse {
+
+/// Which angular rates drive the roll/pitch prediction of the complementary filter.
+enum class GyroToTiltRate : std::uint8_t {
+  /// Seed 001 eq 3-4 as printed: roll rate = gyro_x, pitch rate = gyro_y
+  /// (right for small tilt).
+  kSeed,
+  /// ZYX Euler kinematics: \f$ \dot r = \omega_x + \tan p(\sin r\,\omega_y + \cos r\,\omega_z) \f$,
+  /// \f$ \dot p = \cos r\,\omega_y - \sin r\,\omega_z \f$ (exact at any tilt below 90° pitch).
+  kEulerKinematics,
+};
+
+/// Attitude-chain stage 2: complementary filter on roll and pitch (seed 001
+/// eq 3-4) with \f$ \Delta t \f$ from the sample stamps. Input and Output
+/// TiltedImu; the output's tilt is the filtered estimate. The first sample
+/// initialises from the accelerometer (status kFirst); a sample whose tilt is
+/// not usable (status kNonFinite or a non-finite gyro) leaves the filter
+/// untouched and is passed on with the held estimate and status kNonFinite.
+class ComplementaryTiltStage {
+ public:
+  using Input = TiltedImu;
+  using Output = TiltedImu;
+
+  /// @param[in] alpha filter constant in [0, 1] (seed: gyro weight)
+  /// @param[in] mapping how gyro rates become roll/pitch rates
+  /// @throws posefuse::invalid_argument if alpha is outside [0, 1]
+  explicit ComplementaryTiltStage(double alpha, GyroToTiltRate mapping = GyroToTiltRate::kSeed)
+      : filter_(alpha), mapping_(mapping) {}
+
+  /// @throws posefuse::invalid_argument if the stamp is not finite or not increasing
+  [[nodiscard]] TiltedImu operator()(const TiltedImu& in) {
+    TiltedImu out = in;
+    const Eigen::Vector2d absolute(in.tilt.roll, in.tilt.pitch);
+    const Eigen::Vector3d& g = in.imu.gyro_radps;
+    const Eigen::Vector2d& x = filter_.estimate();
+    Eigen::Vector2d rate(g.x(), g.y());
+    if (mapping_ == GyroToTiltRate::kEulerKinematics) {
+      const double sr = std::sin(x(0)), cr = std::cos(x(0)), tp = std::tan(x(1));
+      rate << g.x() + tp * (sr * g.y() + cr * g.z()), cr * g.y() - sr * g.z();
+    }
+    const Eigen::Vector2d bad = Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
+    const ComplementaryStatus st =
+        filter_.update(in.imu.t_s, rate, in.status == SampleStatus::kNonFinite ? bad : absolute);
+    out.tilt = {filter_.estimate()(0), filter_.estimate()(1)};
+    out.status = st == ComplementaryStatus::kNonFinite  ? SampleStatus::kNonFinite
+                 : st == ComplementaryStatus::kInitialised ? SampleStatus::kFirst
+                                                          : SampleStatus::kOk;
+    return out;
+  }
+
+  /// The underlying filter (estimate, alpha, last stamp).
+  [[nodiscard]] const ComplementaryFilter<double, 2>& filter() const noexcept { return filter_; }
+  /// Forgets the estimate; the next sample initialises again.
+  void reset() noexcept { filter_.reset(); }
+
+ private:
+  ComplementaryFilter<double, 2> filter_;
+  GyroToTiltRate mapping_;
+};
+
+/// Configuration of the attitude chain.
+struct AttitudeConfig {
+  double alpha{0.98};                                 ///< complementary filter constant, [0, 1]
+  GyroToTiltRate gyro_mapping{GyroToTiltRate::kSeed};  ///< eq 3-4 as printed by default
+  MagnetometerCalibration calibration{};              ///< hard/soft iron (identity by default)
+  double declination_rad{0.0};                        ///< added to the magnetic yaw, rad
+};
+
+/// ImuSample -> Attitude (seed 001 eq 1-7).
+using AttitudePipeline = Pipeline<AccelerometerTiltStage, ComplementaryTiltStage, CompassStage>;
+
+/// Builds the attitude chain.
+/// @throws posefuse::invalid_argument if alpha is outside [0, 1] or the
+///         calibration/declination is not finite
+[[nodiscard]] inline AttitudePipeline make_attitude_pipeline(const AttitudeConfig& config = {}) {
+  return AttitudePipeline(AccelerometerTiltStage{},
+                          ComplementaryTiltStage(config.alpha, config.gyro_mapping),
+                          CompassStage(config.calibration, config.declination_rad));
+}
+
+/// StampedWheelTicks -> PoseWithCovariance (seed 001 eq 8-10).
+using OdometryPipeline = Pipeline<FourWheelAverage, DiffDriveOdometry, DeadReckoning>;
+
+/// Builds the odometry chain; `stage<2>()` is the DeadReckoning (for reset()).
+/// @param[in] params robot geometry
+/// @param[in] noise per-wheel encoder noise
+/// @param[in] method kEuler (eq 10 as printed) or kExactArc
+/// @param[in] start initial pose, world frame
+/// @param[in] cov0 initial pose covariance
+/// @throws posefuse::invalid_argument for invalid params, noise, start or cov0
+[[nodiscard]] inline OdometryPipeline make_odometry_pipeline(
+    const DiffDriveParams& params, const WheelNoiseParams& noise = {},
+    Integration method = Integration::kExactArc, const PlanarPose<double>& start = {},
+    const Eigen::Matrix3d& cov0 = Eigen::Matrix3d::Zero()) {
+  return OdometryPipeline(FourWheelAverage{}, DiffDriveOdometry(params, noise),
+                          DeadReckoning(method, start, cov0));
+}
+
+static_assert(Stage<AttitudePipeline>);
+static_assert(Stage<OdometryPipeline>);
+
+}  // namespace posefuse
