@@ -43,6 +43,17 @@ template <std::floating_point T>
   return rad * T(180) / std::numbers::pi_v<T>;
 }
 
+namespace detail {
+/// Direction of the resultant (s, c); NaN when its length is round-off
+/// compared with the total weight (the mean direction is undefined).
+template <std::floating_point T>
+[[nodiscard]] inline T mean_direction(T s, T c, T total_weight) noexcept {
+  if (!(std::hypot(s, c) > T(64) * std::numeric_limits<T>::epsilon() * total_weight))
+    return std::numeric_limits<T>::quiet_NaN();
+  return wrap_angle(std::atan2(s, c));
+}
+}  // namespace detail
+
 /// Weighted circular mean \f$ \mathrm{atan2}(\sum w_i \sin a_i, \sum w_i \cos a_i) \f$.
 /// Averaging 179° and -179° gives 180°, not 0°.
 /// @param[in] a angles in radians
@@ -51,14 +62,14 @@ template <std::floating_point T>
 ///         (e.g. two opposite angles with equal weight) or the input is empty
 template <std::floating_point T>
 [[nodiscard]] inline T circular_mean(std::span<const T> a, std::span<const T> w) noexcept {
-  T s = 0, c = 0;
+  T s = 0, c = 0, total = 0;
   const std::size_t n = a.size() < w.size() ? a.size() : w.size();
   for (std::size_t i = 0; i < n; ++i) {
     s += w[i] * std::sin(a[i]);
     c += w[i] * std::cos(a[i]);
+    total += std::abs(w[i]);
   }
-  if (s == T(0) && c == T(0)) return std::numeric_limits<T>::quiet_NaN();
-  return wrap_angle(std::atan2(s, c));
+  return detail::mean_direction(s, c, total);
 }
 
 /// Unweighted circular mean of a set of angles (see the weighted overload).
@@ -69,8 +80,7 @@ template <std::floating_point T>
     s += std::sin(x);
     c += std::cos(x);
   }
-  if (s == T(0) && c == T(0)) return std::numeric_limits<T>::quiet_NaN();
-  return wrap_angle(std::atan2(s, c));
+  return detail::mean_direction(s, c, static_cast<T>(a.size()));
 }
 
 /// Weighted mean of two angles on the circle: \f$ a + \frac{w_b}{w_a+w_b}\,\mathrm{wrap}(b-a) \f$,
