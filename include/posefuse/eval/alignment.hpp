@@ -1,0 +1,178 @@
+#pragma once
+/// @file
+/// Umeyama SE(3) / Sim(3) alignment of an estimated trajectory to a
+/// reference, as evo's `geometry.umeyama_alignment` and
+/// `trajectory.align_trajectory` (`evo_ape ... -a` / `-as`).
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <posefuse/core/error.hpp>
+#include <posefuse/io/trajectory.hpp>
+
+namespace posefuse {
+
+/// Which alignment to apply before computing a metric.
+enum class Alignment {
+  kNone,  ///< compare as is
+  kSE3,   ///< rotation + translation (evo `--align`)
+  kSim3,  ///< rotation + translation + scale (evo `--align --correct_scale`), for monocular SLAM
+};
+
+/// Parses "none", "se3" or "sim3".
+/// @throws posefuse::invalid_argument for any other text
+[[nodiscard]] inline Alignment parse_alignment(std::string_view name) {
+  if (name == "none") return Alignment::kNone;
+  if (name == "se3") return Alignment::kSE3;
+  if (name == "sim3") return Alignment::kSim3;
+  throw invalid_argument("unknown alignment '" + std::string(name) +
+                         "' (expected none, se3 or sim3)");
+}
+
+/// The name `parse_alignment` accepts for `alignment`.
+[[nodiscard]] constexpr std::string_view to_string(Alignment alignment) noexcept {
+  switch (alignment) {
+    case Alignment::kNone: return "none";
+    case Alignment::kSE3: return "se3";
+    case Alignment::kSim3: return "sim3";
+  }
+  return "?";
+}
+
+/// A similarity \f$ y = c R x + t \f$ mapping estimate positions onto the
+/// reference (identity for `Alignment::kNone`).
+struct AlignmentResult {
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  ///< \f$ R \f$ (est world → ref world)
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();   ///< \f$ t \f$ (m, reference frame)
+  double scale = 1.0;                                      ///< \f$ c \f$ (1 unless Sim(3))
+
+  /// Maps a point: \f$ c R x + t \f$.
+  [[nodiscard]] Eigen::Vector3d apply(const Eigen::Vector3d& x) const {
+    return scale * (rotation * x) + translation;
+  }
+};
+
+/// Least-squares similarity between two registered point sets (Umeyama,
+/// IEEE PAMI 13(4), 1991), as evo's `umeyama_alignment(x, y, with_scale)`:
+/// means (eq. 34-35), \f$ \sigma_x^2 = \frac1n \sum \lVert x_i - \mu_x \rVert^2 \f$
+/// (eq. 36), \f$ \Sigma_{xy} = \frac1n \sum (y_i - \mu_y)(x_i - \mu_x)^\top
+/// = U D V^\top \f$ (eq. 38), \f$ S = \mathrm{diag}(1, 1, -1) \f$ when
+/// \f$ \det U \det V < 0 \f$ (eq. 43), \f$ R = U S V^\top \f$ (eq. 40),
+/// \f$ c = \mathrm{tr}(D S) / \sigma_x^2 \f$ (eq. 42) and
+/// \f$ t = \mu_y - c R \mu_x \f$ (eq. 41).
+/// @param[in] x source points (estimate), at least 3
+/// @param[in] y target points (reference), same count, `y[i]` registered to `x[i]`
+/// @param[in] with_scale estimate \f$ c \f$ (Sim(3)); otherwise \f$ c = 1 \f$ (SE(3))
+/// @return \f$ (R, t, c) \f$ minimising \f$ \sum \lVert y_i - (c R x_i + t) \rVert^2 \f$
+/// @throws posefuse::invalid_argument for different counts, fewer than 3
+///         points, non-finite points, or a covariance of rank < 2 (evo's
+///         "Degenerate covariance rank": e.g. all points identical or collinear)
+[[nodiscard]] inline AlignmentResult umeyama_alignment(std::span<const Eigen::Vector3d> x,
+                                                       std::span<const Eigen::Vector3d> y,
+                                                       bool with_scale) {
+  if (x.size() != y.size()) {
+    throw invalid_argument("umeyama_alignment: " + std::to_string(x.size()) + " source but " +
+                           std::to_string(y.size()) + " target points");
+  }
+  if (x.size() < 3) {
+    throw invalid_argument("umeyama_alignment: needs at least 3 point pairs, got " +
+                           std::to_string(x.size()));
+  }
+  const double n = static_cast<double>(x.size());
+  Eigen::Vector3d mean_x = Eigen::Vector3d::Zero();
+  Eigen::Vector3d mean_y = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    if (!x[i].allFinite() || !y[i].allFinite()) {
+      throw invalid_argument("umeyama_alignment: point pair " + std::to_string(i) +
+                             " is not finite");
+    }
+    mean_x += x[i];
+    mean_y += y[i];
+  }
+  mean_x /= n;
+  mean_y /= n;
+  double sigma_x = 0.0;
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const Eigen::Vector3d dx = x[i] - mean_x;
+    sigma_x += dx.squaredNorm();
+    cov += (y[i] - mean_y) * dx.transpose();
+  }
+  sigma_x /= n;
+  cov /= n;
+
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(cov, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::Vector3d d = svd.singularValues();
+  int rank = 0;
+  for (int i = 0; i < 3; ++i) rank += d(i) > std::numeric_limits<double>::epsilon() ? 1 : 0;
+  if (rank < 2) {
+    throw invalid_argument("umeyama_alignment: degenerate covariance rank " + std::to_string(rank) +
+                           " (points identical or collinear), alignment is not possible");
+  }
+  Eigen::Matrix3d S = Eigen::Matrix3d::Identity();
+  if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0.0) S(2, 2) = -1.0;
+
+  AlignmentResult r;
+  r.rotation = svd.matrixU() * S * svd.matrixV().transpose();
+  r.scale = with_scale ? (d.asDiagonal() * S).trace() / sigma_x : 1.0;
+  r.translation = mean_y - r.scale * (r.rotation * mean_x);
+  return r;
+}
+
+/// Applies a similarity to a trajectory the way evo does: first scale the
+/// positions \f$ p_k \leftarrow c\,p_k \f$ (rotations untouched), then
+/// left-multiply every pose by the SE(3) \f$ [R \mid t] \f$:
+/// \f$ T_k \leftarrow [R \mid t]\,T_k \f$. The result is again SE(3).
+/// @param[in] traj the trajectory to move
+/// @param[in] a the similarity
+/// @return the moved trajectory (stamps unchanged)
+[[nodiscard]] inline Trajectory apply_alignment(const Trajectory& traj, const AlignmentResult& a) {
+  Eigen::Isometry3d T_align = Eigen::Isometry3d::Identity();
+  T_align.linear() = a.rotation;
+  T_align.translation() = a.translation;
+  Trajectory out = traj;
+  for (Eigen::Isometry3d& T : out.poses) {
+    T.translation() *= a.scale;
+    T = T_align * T;
+  }
+  return out;
+}
+
+/// An aligned trajectory with the similarity that produced it.
+struct AlignedTrajectory {
+  Trajectory trajectory;      ///< the estimate moved onto the reference
+  AlignmentResult transform;  ///< \f$ (R, t, c) \f$ used
+};
+
+/// Aligns `est` to `ref` over all their (already associated) positions, as
+/// evo's `align_trajectory(est, ref, correct_scale)`.
+/// @param[in] est estimate, pose k registered to `ref` pose k
+/// @param[in] ref reference
+/// @param[in] alignment kNone (returns `est` and the identity), kSE3 or kSim3
+/// @return the aligned estimate and the similarity
+/// @throws posefuse::invalid_argument for different sizes or the
+///         degenerate cases of `umeyama_alignment`
+[[nodiscard]] inline AlignedTrajectory align_trajectory(const Trajectory& est,
+                                                        const Trajectory& ref,
+                                                        Alignment alignment) {
+  if (est.size() != ref.size()) {
+    throw invalid_argument("align_trajectory: estimate has " + std::to_string(est.size()) +
+                           " poses but reference has " + std::to_string(ref.size()) +
+                           " (associate them first)");
+  }
+  if (alignment == Alignment::kNone) return {est, AlignmentResult{}};
+  const std::vector<Eigen::Vector3d> x = est.positions();
+  const std::vector<Eigen::Vector3d> y = ref.positions();
+  const AlignmentResult a = umeyama_alignment(x, y, alignment == Alignment::kSim3);
+  return {apply_alignment(est, a), a};
+}
+
+}  // namespace posefuse
