@@ -93,6 +93,35 @@ S zero_state() {
     return S{};
   }
 }
+
+/// Inverts a symmetric matrix if it is positive definite. Sizes 1 and 2 use
+/// Sylvester's criterion and the closed-form inverse (a few flops, no
+/// branches on the data beyond the test); larger sizes use Cholesky.
+/// @return false (and leaves `inv` unspecified) unless S is positive definite
+template <class Mat>
+[[nodiscard]] inline bool spd_inverse(const Mat& S, Mat& inv) {
+  using T = typename Mat::Scalar;
+  constexpr int N = Mat::RowsAtCompileTime;
+  if constexpr (N == 1) {
+    if (!(S(0, 0) > T(0))) return false;
+    inv(0, 0) = T(1) / S(0, 0);
+    return true;
+  } else if constexpr (N == 2) {
+    const T det = S(0, 0) * S(1, 1) - S(0, 1) * S(1, 0);
+    if (!(S(0, 0) > T(0) && det > T(0))) return false;
+    const T r = T(1) / det;
+    inv(0, 0) = S(1, 1) * r;
+    inv(1, 1) = S(0, 0) * r;
+    inv(0, 1) = -S(0, 1) * r;
+    inv(1, 0) = -S(1, 0) * r;
+    return true;
+  } else {
+    const Eigen::LLT<Mat> llt(S);
+    if (llt.info() != Eigen::Success) return false;
+    inv = llt.solve(Mat::Identity());
+    return true;
+  }
+}
 }  // namespace detail
 
 /// An EKF over `Motion` with measurement models `Sensors...`.
@@ -191,24 +220,23 @@ class Ekf {
     const SMat R = sensor.noise();
     Gain K;
     Covariance P_new;
+    SMat S_inv;
     if constexpr (has_identity_jacobian_v<H> && ZDim == Dim) {
       out.S = P_ + R;
-      const Eigen::LLT<SMat> llt(out.S);
-      if (llt.info() != Eigen::Success) return fail(out, FilterStatus::kNotPositiveDefinite);
-      out.nis = out.innovation.dot(llt.solve(out.innovation));
+      if (!detail::spd_inverse(out.S, S_inv)) return fail(out, FilterStatus::kNotPositiveDefinite);
+      out.nis = out.innovation.dot(S_inv * out.innovation);
       if (!(out.nis <= gate)) return fail(out, FilterStatus::kGated);
-      K = llt.solve(P_).transpose();  // K = P S^-1 (P, S symmetric)
+      K = P_ * S_inv;
       const Covariance I_K = Covariance::Identity() - K;
       P_new = I_K * P_ * I_K.transpose() + K * R * K.transpose();
     } else {
       const MeasurementJacobianOf<H> J = sensor.jacobian(x_);
       const Eigen::Matrix<Scalar, ZDim, Dim> JP = J * P_;
       out.S = JP * J.transpose() + R;
-      const Eigen::LLT<SMat> llt(out.S);
-      if (llt.info() != Eigen::Success) return fail(out, FilterStatus::kNotPositiveDefinite);
-      out.nis = out.innovation.dot(llt.solve(out.innovation));
+      if (!detail::spd_inverse(out.S, S_inv)) return fail(out, FilterStatus::kNotPositiveDefinite);
+      out.nis = out.innovation.dot(S_inv * out.innovation);
       if (!(out.nis <= gate)) return fail(out, FilterStatus::kGated);
-      K = llt.solve(JP).transpose();  // K = P J^T S^-1
+      K = JP.transpose() * S_inv;  // K = P J^T S^-1
       const Covariance I_KH = Covariance::Identity() - K * J;
       P_new = I_KH * P_ * I_KH.transpose() + K * R * K.transpose();
     }

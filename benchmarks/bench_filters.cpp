@@ -1,0 +1,129 @@
+// Per-step cost of seed 000's EKF (predict + update, G = H = I, 2-D state).
+//
+//   cmake --preset release && cmake --build --preset release --target bench_filters
+//   ./build-release/benchmarks/bench_filters
+//
+// Side by side in this binary:
+//   BM_Seed000Ekf_Step/posefuse      posefuse::Ekf (fixed-size, Joseph form, LLT,
+//                                    identity Jacobians skipped at compile time)
+//   BM_Seed000Ekf_Step/naive_fixed   the textbook step written directly with
+//                                    fixed-size Eigen (G, H multiplied, S inverted)
+//   BM_Seed000Ekf_Step/dynamic       the same textbook step with Eigen::MatrixXd
+//   BM_ConstantVelocityEkf_Step      4-D constant-velocity predict + 2-D fix
+// Inputs are generated once outside the timed loop; each iteration runs one
+// frame of a 1024-frame sequence.
+#include <Eigen/Dense>
+#include <benchmark/benchmark.h>
+#include <posefuse/filters/ekf.hpp>
+#include <posefuse/models/constant_velocity.hpp>
+#include <posefuse/models/planar_displacement.hpp>
+#include <posefuse/models/position.hpp>
+#include <random>
+#include <vector>
+
+namespace {
+
+struct Frames {
+  std::vector<Eigen::Vector2d> u, z;
+};
+
+const Frames& frames() {
+  static const Frames f = [] {
+    Frames out;
+    std::mt19937 rng(3);
+    std::normal_distribution<double> n(0.0, 0.3);
+    Eigen::Vector2d p(0, 0);
+    for (int k = 0; k < 1024; ++k) {
+      const Eigen::Vector2d step(1.0 + n(rng), 0.2 * n(rng));
+      p += step;
+      out.u.push_back(step);
+      out.z.push_back(p + Eigen::Vector2d(n(rng), n(rng)));
+    }
+    return out;
+  }();
+  return f;
+}
+
+void BM_Seed000Ekf_Step_posefuse(benchmark::State& state) {
+  const Frames& f = frames();
+  posefuse::Ekf<posefuse::PlanarDisplacement<double>, posefuse::PositionFix<2>> ekf(
+      posefuse::PlanarDisplacement<double>::from_sigmas(0.1, 0.1),
+      posefuse::PositionFix<2>::isotropic(0.5));
+  ekf.reset(f.z[0], Eigen::Matrix2d::Identity());
+  std::size_t k = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(ekf.predict(f.u[k], 1.0));
+    auto r = ekf.update<0>(f.z[k]);
+    benchmark::DoNotOptimize(r);
+    k = (k + 1) & 1023;
+  }
+  benchmark::DoNotOptimize(ekf.state());
+}
+BENCHMARK(BM_Seed000Ekf_Step_posefuse)->Name("BM_Seed000Ekf_Step/posefuse");
+
+void BM_Seed000Ekf_Step_naive_fixed(benchmark::State& state) {
+  const Frames& f = frames();
+  const Eigen::Matrix2d G = Eigen::Matrix2d::Identity();
+  const Eigen::Matrix2d H = Eigen::Matrix2d::Identity();
+  const Eigen::Matrix2d R = Eigen::Matrix2d::Identity() * 0.01;
+  const Eigen::Matrix2d Q = Eigen::Matrix2d::Identity() * 0.25;
+  Eigen::Vector2d mu = f.z[0];
+  Eigen::Matrix2d S = Eigen::Matrix2d::Identity();
+  std::size_t k = 0;
+  for (auto _ : state) {
+    const Eigen::Vector2d mubar = mu + f.u[k];
+    const Eigen::Matrix2d Sbar = G * S * G.transpose() + R;
+    const Eigen::Matrix2d K = Sbar * H.transpose() * (H * Sbar * H.transpose() + Q).inverse();
+    mu = mubar + K * (f.z[k] - H * mubar);
+    S = (Eigen::Matrix2d::Identity() - K * H) * Sbar;
+    benchmark::DoNotOptimize(mu);
+    benchmark::DoNotOptimize(S);
+    k = (k + 1) & 1023;
+  }
+}
+BENCHMARK(BM_Seed000Ekf_Step_naive_fixed)->Name("BM_Seed000Ekf_Step/naive_fixed");
+
+void BM_Seed000Ekf_Step_dynamic(benchmark::State& state) {
+  const Frames& f = frames();
+  const Eigen::MatrixXd G = Eigen::MatrixXd::Identity(2, 2);
+  const Eigen::MatrixXd H = Eigen::MatrixXd::Identity(2, 2);
+  const Eigen::MatrixXd I = Eigen::MatrixXd::Identity(2, 2);
+  const Eigen::MatrixXd R = Eigen::MatrixXd::Identity(2, 2) * 0.01;
+  const Eigen::MatrixXd Q = Eigen::MatrixXd::Identity(2, 2) * 0.25;
+  Eigen::VectorXd mu = f.z[0];
+  Eigen::MatrixXd S = Eigen::MatrixXd::Identity(2, 2);
+  std::size_t k = 0;
+  for (auto _ : state) {
+    const Eigen::VectorXd u = f.u[k];
+    const Eigen::VectorXd z = f.z[k];
+    const Eigen::VectorXd mubar = mu + u;
+    const Eigen::MatrixXd Sbar = G * S * G.transpose() + R;
+    const Eigen::MatrixXd Sinn = H * Sbar * H.transpose() + Q;
+    const Eigen::MatrixXd K = Sbar * H.transpose() * Sinn.inverse();
+    mu = mubar + K * (z - H * mubar);
+    S = (I - K * H) * Sbar;
+    benchmark::DoNotOptimize(mu.data());
+    benchmark::DoNotOptimize(S.data());
+    k = (k + 1) & 1023;
+  }
+}
+BENCHMARK(BM_Seed000Ekf_Step_dynamic)->Name("BM_Seed000Ekf_Step/dynamic");
+
+void BM_ConstantVelocityEkf_Step(benchmark::State& state) {
+  const Frames& f = frames();
+  posefuse::Ekf<posefuse::ConstantVelocity2<double>, posefuse::PositionFix<4>> ekf(
+      posefuse::ConstantVelocity2<double>(1.0), posefuse::PositionFix<4>::isotropic(0.5));
+  Eigen::Vector4d x0;
+  x0 << f.z[0], 0, 0;
+  ekf.reset(x0, Eigen::Matrix4d::Identity());
+  std::size_t k = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(ekf.predict(posefuse::NoControl{}, 0.1));
+    auto r = ekf.update<0>(f.z[k]);
+    benchmark::DoNotOptimize(r);
+    k = (k + 1) & 1023;
+  }
+}
+BENCHMARK(BM_ConstantVelocityEkf_Step);
+
+}  // namespace
