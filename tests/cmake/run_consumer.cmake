@@ -1,0 +1,22 @@
+# Configures, builds and runs tests/cmake/consumer in one mode.
+# -DMODE=subdirectory|package -DSOURCE=<posefuse> -DPREFIX=<install prefix> -DWORK=<dir>
+file(REMOVE_RECURSE "${WORK}")
+set(args -S "${SOURCE}/tests/cmake/consumer" -B "${WORK}" -DPOSEFUSE_CONSUMER_MODE=${MODE}
+         -DCMAKE_BUILD_TYPE=Release)
+if(MODE STREQUAL "subdirectory")
+  list(APPEND args -DPOSEFUSE_SOURCE=${SOURCE})
+else()
+  list(APPEND args -DCMAKE_PREFIX_PATH=${PREFIX})
+endif()
+foreach(step IN ITEMS configure build run)
+  if(step STREQUAL "configure")
+    execute_process(COMMAND "${CMAKE_COMMAND}" ${args} RESULT_VARIABLE rc)
+  elseif(step STREQUAL "build")
+    execute_process(COMMAND "${CMAKE_COMMAND}" --build "${WORK}" RESULT_VARIABLE rc)
+  else()
+    execute_process(COMMAND "${WORK}/consumer" RESULT_VARIABLE rc)
+  endif()
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "consumer (${MODE}): ${step} failed: ${rc}")
+  endif()
+endforeach()
