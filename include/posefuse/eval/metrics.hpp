@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <numbers>
 #include <span>
+#include <sstream>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -251,7 +252,9 @@ struct RpeOptions {
     r.pairs = rpe_pairs_by_path(options.pairs_from_reference ? Q : P, options.delta);
   }
   if (r.pairs.empty()) {
-    throw invalid_argument("rpe: delta = " + std::to_string(options.delta) +
+    std::ostringstream delta;
+    delta << options.delta;
+    throw invalid_argument("rpe: delta = " + delta.str() +
                            (options.delta_unit == DeltaUnit::kFrames ? " (frames)" : " (m)") +
                            " produced an empty index list - try lower values");
   }
