@@ -20,6 +20,7 @@
 #include <concepts>
 #include <cstdint>
 #include <limits>
+#include <type_traits>
 #include <posefuse/core/angles.hpp>
 #include <posefuse/core/concepts.hpp>
 #include <posefuse/models/planar_pose.hpp>
@@ -59,8 +60,8 @@ inline void sinc_and_derivative(T a, T& s, T& ds) noexcept {
 template <std::floating_point T>
 [[nodiscard]] inline PlanarPose<T> unicycle_step(const PlanarPose<T>& x, T ds_m, T dtheta_rad,
                                                  Integration method,
-                                                 Eigen::Matrix<T, 3, 3>* J_x = nullptr,
-                                                 Eigen::Matrix<T, 3, 2>* J_u = nullptr) noexcept {
+                                                 std::type_identity_t<Eigen::Matrix<T, 3, 3>>* J_x = nullptr,
+                                                 std::type_identity_t<Eigen::Matrix<T, 3, 2>>* J_u = nullptr) noexcept {
   PlanarPose<T> out;
   out.theta = wrap_angle(x.theta + dtheta_rad);
   if (method == Integration::kEuler) {
