@@ -174,16 +174,16 @@ class Ekf {
     if (dt < Scalar(0)) return FilterStatus::kInvalidInput;
     const StateType x_new = motion_.predict(x_, u, dt);
     Covariance P_new;
-    Covariance F;
     if constexpr (has_identity_jacobian_v<Motion>) {
-      F.setIdentity();
       P_new = P_ + Covariance(motion_.noise(x_, u, dt));
+      if (!minus(x_new, x_).allFinite() || !P_new.allFinite()) return FilterStatus::kNonFinite;
+      // F_ stays the identity it was initialised to.
     } else {
-      F = motion_.jacobian(x_, u, dt);
+      const Covariance F = motion_.jacobian(x_, u, dt);
       P_new = F * P_ * F.transpose() + Covariance(motion_.noise(x_, u, dt));
+      if (!minus(x_new, x_).allFinite() || !P_new.allFinite()) return FilterStatus::kNonFinite;
+      F_ = F;
     }
-    if (!minus(x_new, x_).allFinite() || !P_new.allFinite()) return FilterStatus::kNonFinite;
-    F_ = F;
     x_ = x_new;
     P_ = symmetrised(P_new);
     return FilterStatus::kApplied;
