@@ -155,22 +155,27 @@ template <std::floating_point T>
 }
 
 /// SO(3) logarithm: the rotation vector (rad) of R, with |result| in [0, pi].
-/// Near pi the axis is taken from the diagonal of R, so it stays accurate.
+/// The angle comes from atan2(sin, cos), accurate at every angle; beyond 90°
+/// the axis is taken from the symmetric part of R, so it stays accurate near pi.
 /// @param[in] R rotation matrix, assumed orthonormal
 template <class Derived>
 [[nodiscard]] inline Eigen::Matrix<typename Derived::Scalar, 3, 1> so3_log(
     const Eigen::MatrixBase<Derived>& R) {
   using T = typename Derived::Scalar;
   using V = Eigen::Matrix<T, 3, 1>;
-  const Eigen::Matrix<T, 3, 3> M = R;
-  const T cos_th = std::clamp((M.trace() - T(1)) / T(2), T(-1), T(1));
+  using M3 = Eigen::Matrix<T, 3, 3>;
+  const M3 M = R;
+  const T cos_th = (M.trace() - T(1)) / T(2);
   const V vee{M(2, 1) - M(1, 2), M(0, 2) - M(2, 0), M(1, 0) - M(0, 1)};  // 2 sin(th) axis
-  const T th = std::acos(cos_th);
-  if (th < gimbal_lock_tolerance<T>()) return T(0.5) * (T(1) + th * th / T(6)) * vee;
-  if (std::numbers::pi_v<T> - th > T(1e-3)) return (th / (T(2) * std::sin(th))) * vee;
-  // Near pi: R + R^T = 2 cos th I + 2 (1 - cos th) a a^T; use the largest column.
-  const Eigen::Matrix<T, 3, 3> B = (M + M.transpose() - T(2) * cos_th * Eigen::Matrix<T, 3, 3>::Identity()) /
-                                   (T(2) * (T(1) - cos_th));
+  const T sin_th = vee.norm() / T(2);
+  const T th = std::atan2(sin_th, cos_th);
+  if (th < detail::so3_series_threshold<T>()) {
+    const T th2 = th * th;  // th / (2 sin th) = (1 + th^2/6 + 7 th^4/360) / 2
+    return (T(0.5) + th2 / T(12) + T(7) * th2 * th2 / T(720)) * vee;
+  }
+  if (cos_th >= T(0)) return (th / (T(2) * sin_th)) * vee;
+  // Beyond 90 deg: R + R^T = 2 cos th I + 2 (1 - cos th) a a^T; use the largest column.
+  const M3 B = (M + M.transpose() - T(2) * cos_th * M3::Identity()) / (T(2) * (T(1) - cos_th));
   Eigen::Index k = 0;
   B.diagonal().maxCoeff(&k);
   V axis = B.col(k) / std::sqrt(B(k, k));
