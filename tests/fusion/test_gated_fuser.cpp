@@ -1,0 +1,255 @@
+// The sound fuser: information weighting, gates, angle awareness, re-anchoring.
+#include <catch2/catch.hpp>
+
+#include <Eigen/LU>
+#include <cmath>
+#include <numbers>
+#include <posefuse/core/pipeline.hpp>
+#include <posefuse/fusion/gated_fuser.hpp>
+
+using posefuse::FuserStatus;
+using posefuse::GatedFuser;
+using posefuse::GatedFuserParams;
+using Pose = posefuse::PlanarPose<double>;
+
+static_assert(posefuse::Stage<GatedFuser<double>>);
+static_assert(posefuse::Stage<GatedFuser<float>>);
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// True pose on a 2 m-radius circle driven counter-clockwise, at arc length s.
+Pose circle(double s) {
+  const double a = s / 2.0;
+  return {2.0 * std::sin(a), 2.0 - 2.0 * std::cos(a), posefuse::wrap_angle(a)};
+}
+
+// Odometry that drifts: heading error grows 2° per metre, so its frame rotates away.
+Pose drifting_odometry(double s) {
+  const double drift = 2.0 * kPi / 180.0;
+  Pose p{0, 0, 0};
+  const int n = int(s / 0.01);
+  for (int i = 0; i < n; ++i) {
+    const double a = (i + 0.5) * 0.01 / 2.0 + drift * (i + 0.5) * 0.01;
+    p.x += 0.01 * std::cos(a);
+    p.y += 0.01 * std::sin(a);
+  }
+  p.theta = posefuse::wrap_angle(s / 2.0 + drift * s);
+  return p;
+}
+
+double distance(const Pose& a, const Pose& b) { return std::hypot(a.x - b.x, a.y - b.y); }
+
+}  // namespace
+
+TEST_CASE("GatedFuser: SE(2) helpers", "[fusion][gated]") {
+  const Pose a{1.0, -2.0, 2.5}, b{0.3, 0.7, -3.0};
+  const Pose e = posefuse::se2_compose(posefuse::se2_inverse(a), a);
+  CHECK(e.x == Approx(0).margin(1e-12));
+  CHECK(e.y == Approx(0).margin(1e-12));
+  CHECK(e.theta == Approx(0).margin(1e-12));
+  const Pose c = posefuse::se2_compose(a, b);
+  const Pose back = posefuse::se2_compose(c, posefuse::se2_inverse(b));
+  CHECK(back.x == Approx(a.x));
+  CHECK(back.y == Approx(a.y));
+  CHECK(back.theta == Approx(a.theta));
+}
+
+TEST_CASE("GatedFuser: fuse_poses is the information-weighted mean", "[fusion][gated]") {
+  Eigen::Matrix3d Pa = Eigen::Vector3d(0.04, 0.01, 0.001).asDiagonal();
+  Eigen::Matrix3d Pb = Eigen::Vector3d(0.01, 0.04, 0.003).asDiagonal();
+  const Pose a{1.0, 2.0, 0.1}, b{2.0, 1.0, 0.2};
+  const auto f = posefuse::fuse_poses(a, Pa, b, Pb);
+  const Eigen::Matrix3d P = (Pa.inverse() + Pb.inverse()).inverse();
+  const Eigen::Vector3d x = P * (Pa.inverse() * a.vector() + Pb.inverse() * b.vector());
+  CHECK(f.pose.x == Approx(x(0)));  // 1.8
+  CHECK(f.pose.y == Approx(x(1)));  // 1.8
+  CHECK(f.pose.theta == Approx(x(2)));  // 0.125
+  CHECK(f.pose.x == Approx(1.8));
+  CHECK(f.pose.theta == Approx(0.125));
+  CHECK((f.cov - P).cwiseAbs().maxCoeff() < 1e-12);
+  // Across ±180°: 170° (weight 3) and -170° (weight 1) fuse to 175°.
+  const double d = kPi / 180.0;
+  const Eigen::Matrix3d P1 = Eigen::Matrix3d::Identity() * 0.01, P3 = P1 * 3.0;
+  const auto g = posefuse::fuse_poses<double>({0, 0, 170 * d}, P1, {0, 0, -170 * d}, P3);
+  CHECK(g.pose.theta == Approx(175 * d));
+}
+
+TEST_CASE("GatedFuser: the first SLAM poses anchor the map frame, then SLAM is fused",
+          "[fusion][gated]") {
+  GatedFuser<double> f;  // >= 8 anchor samples over >= 0.5 m
+  const Pose T_wm{3.0, -1.0, 2.0};  // SLAM map frame, unknown to the fuser
+  int fused = 0, anchored_at = -1;
+  for (int k = 0; k <= 300; ++k) {
+    const double s = 0.02 * k;
+    REQUIRE(f.predict(drifting_odometry(s)) == FuserStatus::kPredicted);
+    const Pose z = posefuse::se2_compose(posefuse::se2_inverse(T_wm), circle(s));
+    const FuserStatus st = f.update_slam(z, false);
+    if (anchored_at < 0) CHECK((st == FuserStatus::kAnchoring || st == FuserStatus::kAnchored));
+    if (st == FuserStatus::kAnchored) anchored_at = k;
+    fused += st == FuserStatus::kFused;
+  }
+  CHECK(anchored_at >= 25);  // 0.5 m of travel at 2 cm per sample
+  CHECK(anchored_at <= 26);
+  CHECK(fused == 300 - anchored_at);
+  CHECK(f.anchored());
+  CHECK(f.anchor_count() == 1);
+  // The anchored map frame is the true one up to the odometry's drift while
+  // anchoring (2°/m here, about 1° over the 0.5 m window — unobservable), and
+  // the fused pose follows the truth far better than the drifting odometry.
+  CHECK(distance(f.map_in_world(), T_wm) < 0.05);
+  CHECK(std::abs(posefuse::angle_diff(f.map_in_world().theta, T_wm.theta)) < 0.03);
+  CHECK(distance(f.pose(), circle(6.0)) < 0.1);
+  CHECK(distance(drifting_odometry(6.0), circle(6.0)) > 0.45);
+  // Rebasing: the correction maps the odometry frame onto the fused estimate.
+  const Pose rebased = posefuse::se2_compose(f.odometry_correction(), drifting_odometry(6.0));
+  CHECK(distance(rebased, f.pose()) < 1e-9);
+}
+
+TEST_CASE("GatedFuser: a re-initialised SLAM map is re-anchored, not discarded",
+          "[fusion][gated][reanchor]") {
+  // Two fusers see the same drifting odometry; SLAM is lost for 2 m and comes
+  // back in a new map frame. One re-anchors it; the other (as the seed's fuser
+  // effectively does with a map it cannot place) gets no SLAM after the loss.
+  GatedFuser<double> f, discard;
+  const Pose map0{0, 0, 0}, map1{-4.0, 7.0, -2.5};
+  int anchored = 0, fused_after = 0;
+  double max_jump = 0;
+  Pose prev = f.pose();
+  for (int k = 0; k <= 600; ++k) {
+    const double s = 0.02 * k;
+    (void)f.predict(drifting_odometry(s));
+    (void)discard.predict(drifting_odometry(s));
+    const bool lost = k > 200 && k < 300;  // SLAM lost for 2 m
+    if (!lost) {
+      const Pose& m = k <= 200 ? map0 : map1;
+      const Pose z = posefuse::se2_compose(posefuse::se2_inverse(m), circle(s));
+      const bool reinit = k == 300;  // first pose in the new frame
+      const FuserStatus st = f.update_slam(z, reinit);
+      if (k <= 200) (void)discard.update_slam(z, false);
+      anchored += st == FuserStatus::kAnchored;
+      if (k > 340) fused_after += st == FuserStatus::kFused;
+    }
+    max_jump = std::max(max_jump, distance(prev, f.pose()));
+    prev = f.pose();
+  }
+  CHECK(anchored == 2);  // first map, then the re-initialised one
+  CHECK(fused_after == 260);
+  CHECK(max_jump < 0.1);  // continuous: no jump into the new map frame
+  // What remains is the heading drift accumulated while SLAM was lost (about
+  // 5° here), which no fuser can observe; re-anchoring stops further drift.
+  const double err = distance(f.pose(), circle(12.0));
+  const double err_discard = distance(discard.pose(), circle(12.0));
+  CHECK(err < 0.4);
+  CHECK(err < 0.6 * err_discard);  // 0.35 m vs 0.69 m
+}
+
+TEST_CASE("GatedFuser: an unannounced SLAM frame jump is rejected, then re-anchored",
+          "[fusion][gated][reanchor]") {
+  GatedFuserParams<double> p;
+  p.reanchor_after_rejects = 5;
+  GatedFuser<double> f(p);
+  const Pose map1{2.0, 2.0, 1.0};
+  int rejected = 0, anchored = 0;
+  for (int k = 0; k <= 400; ++k) {
+    const double s = 0.02 * k;
+    (void)f.predict(circle(s));
+    const Pose z = s < 4.0 ? circle(s) : posefuse::se2_compose(posefuse::se2_inverse(map1), circle(s));
+    const FuserStatus st = f.update_slam(z, false);
+    rejected += posefuse::is_rejection(st);
+    anchored += st == FuserStatus::kAnchored;
+  }
+  CHECK(rejected == 5);
+  CHECK(anchored == 2);
+  CHECK(distance(f.pose(), circle(8.0)) < 0.05);
+}
+
+TEST_CASE("GatedFuser: a frozen SLAM pose does not get anchored", "[fusion][gated]") {
+  GatedFuser<double> f;
+  for (int k = 0; k <= 100; ++k) {
+    (void)f.predict({0.027 * k, 0, 0});  // 0.4 m/s with SLAM at 15 Hz
+    CHECK(f.update_slam({0, 0, 0}, false) == FuserStatus::kAnchoring);
+  }
+  CHECK_FALSE(f.anchored());
+  CHECK(f.pose().x == Approx(2.7));
+}
+
+TEST_CASE("GatedFuser: separate gates reject position or heading alone; Mahalanobis mode",
+          "[fusion][gated]") {
+  GatedFuserParams<double> p;
+  p.anchor_samples = 1;
+  p.anchor_min_travel_m = 0;
+  for (auto mode : {posefuse::GateMode::kSeparate, posefuse::GateMode::kMahalanobis,
+                    posefuse::GateMode::kBoth}) {
+    p.gate = mode;
+    GatedFuser<double> f(p);
+    (void)f.predict({0, 0, 0});
+    REQUIRE(f.update_slam({0, 0, 0}, false) == FuserStatus::kAnchored);
+    (void)f.predict({1, 0, 0});
+    const FuserStatus pos = f.update_slam({1.5, 0, 0}, false);       // 0.5 m off, same heading
+    const FuserStatus head = f.update_slam({1.0, 0, 0.5}, false);    // same place, 29° off
+    const FuserStatus ok = f.update_slam({1.02, -0.01, 0.01}, false);
+    if (mode == posefuse::GateMode::kMahalanobis) {
+      CHECK(pos == FuserStatus::kRejectedJoint);
+      CHECK(head == FuserStatus::kRejectedJoint);
+    } else {
+      CHECK(pos == FuserStatus::kRejectedPosition);
+      CHECK(head == FuserStatus::kRejectedHeading);
+    }
+    CHECK(ok == FuserStatus::kFused);
+  }
+}
+
+TEST_CASE("GatedFuser: heading updates and non-finite input", "[fusion][gated]") {
+  GatedFuser<double> f;
+  (void)f.predict({0, 0, 0});
+  (void)f.predict({1, 0, 0.2});
+  const double var0 = f.covariance()(2, 2);
+  CHECK(f.update_heading(0.21, 0.05) == FuserStatus::kFused);
+  CHECK(f.covariance()(2, 2) < var0);
+  CHECK(f.pose().theta > 0.2);
+  CHECK(f.update_heading(0.2 + kPi / 2, 0.01) == FuserStatus::kRejectedHeading);
+  const Pose before = f.pose();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  CHECK(f.predict({nan, 0, 0}) == FuserStatus::kNonFinite);
+  CHECK(f.update_slam({0, nan, 0}, false) == FuserStatus::kNonFinite);
+  CHECK(f.update_heading(nan, 0.1) == FuserStatus::kNonFinite);
+  CHECK(f.pose().x == before.x);
+}
+
+TEST_CASE("GatedFuser: invalid parameters throw", "[fusion][gated]") {
+  GatedFuserParams<double> p;
+  p.slam_xy_sigma_m = 0;
+  CHECK_THROWS_AS(GatedFuser<double>(p), posefuse::invalid_argument);
+  p = {};
+  p.odom_xy_sigma_per_sqrt_m = -1;
+  CHECK_THROWS_AS(GatedFuser<double>(p), posefuse::invalid_argument);
+  p = {};
+  p.anchor_samples = 0;
+  CHECK_THROWS_AS(GatedFuser<double>(p), posefuse::invalid_argument);
+  p.anchor_samples = 33;
+  CHECK_THROWS_AS(GatedFuser<double>(p), posefuse::invalid_argument);
+  p = {};
+  p.anchor_min_travel_m = -0.1;
+  CHECK_THROWS_AS(GatedFuser<double>(p), posefuse::invalid_argument);
+  p = {};
+  p.reanchor_after_rejects = 0;
+  CHECK_THROWS_AS(GatedFuser<double>(p), posefuse::invalid_argument);
+}
+
+TEMPLATE_TEST_CASE("GatedFuser: stage form in float and double", "[fusion][gated]", float, double) {
+  using T = TestType;
+  GatedFuser<T> f;
+  typename GatedFuser<T>::Output out{};
+  for (int k = 0; k <= 50; ++k) {
+    typename GatedFuser<T>::Input in;
+    in.odom = {T(0.05) * T(k), T(0), T(0)};
+    in.has_slam = true;
+    in.slam = {T(0.05) * T(k) + T(0.01), T(0), T(0)};
+    out = f(in);
+  }
+  CHECK(out.slam_status == FuserStatus::kFused);
+  CHECK(out.pose.x == Approx(2.5).margin(0.02));
+  CHECK(out.cov(0, 0) > T(0));
+}
