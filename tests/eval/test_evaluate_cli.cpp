@@ -3,46 +3,20 @@
 // on stderr. Skipped visibly when the example has not been built.
 #include <catch2/catch.hpp>
 
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
-#include <sys/wait.h>
 
 #include <posefuse/eval/metrics.hpp>
 #include <posefuse/io/association.hpp>
 #include <posefuse/io/formats.hpp>
 
 #include "support/synthetic_trajectory.hpp"
-#include "support/temp_dir.hpp"
+#include "support/run_program.hpp"
 
 namespace {
 
-struct Run {
-  int status = -1;
-  std::string out, err;
-};
-
-std::string slurp(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-Run run(const std::filesystem::path& exe, const std::string& args,
-        const posefuse::test::TempDir& dir) {
-  const auto out = dir.path() / "stdout.txt", err = dir.path() / "stderr.txt";
-  const std::string cmd =
-      "'" + exe.string() + "' " + args + " >'" + out.string() + "' 2>'" + err.string() + "'";
-  const int raw = std::system(cmd.c_str());
-  Run r;
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
-}
+using posefuse::test::Run;
+using posefuse::test::run;
 
 double json_number(const std::string& json, const std::string& key) {
   const std::string tag = "\"" + key + "\": ";
@@ -60,12 +34,7 @@ std::size_t count_lines(const std::string& s) {
 }  // namespace
 
 TEST_CASE("Evaluate CLI: JSON output equals the library and errors exit cleanly", "[eval][cli]") {
-  const std::filesystem::path exe =
-      std::filesystem::path(POSEFUSE_EXAMPLES_DIR) / "evaluate_trajectory";
-  if (!std::filesystem::exists(exe)) {
-    WARN("SKIPPED: " << exe << " not built (configure with POSEFUSE_BUILD_EXAMPLES=ON)");
-    return;
-  }
+  POSEFUSE_REQUIRE_EXAMPLE(exe, "evaluate_trajectory");
   posefuse::test::TempDir dir("cli");
   const posefuse::Trajectory ref = posefuse::test::make_vehicle_trajectory(400, 21, 100.0);
   posefuse::Trajectory est = posefuse::test::perturb(ref, 0.3, 0.01, 22);
