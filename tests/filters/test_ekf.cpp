@@ -1,5 +1,6 @@
 #include <catch2/catch.hpp>
 #include <limits>
+#include <random>
 #include <posefuse/core/chi_square.hpp>
 #include <posefuse/filters/ekf.hpp>
 #include <posefuse/models/constant_velocity.hpp>
@@ -191,4 +192,31 @@ TEST_CASE("chi_square_quantile: known table values", "[filters][chi2]") {
   CHECK(chi_square_cdf(chi_square_quantile(0.5, 10), 10) == Approx(0.5).epsilon(1e-12));
   CHECK_THROWS_AS(chi_square_quantile(1.0, 2), posefuse::invalid_argument);
   CHECK_THROWS_AS(chi_square_quantile(0.5, 0), posefuse::invalid_argument);
+}
+
+TEST_CASE("Ekf: reusing a converged gain is bit-identical to recomputing it",
+          "[filters][ekf][steady]") {
+  // update<0> reuses the covariance part while P repeats (PositionFix is
+  // time-invariant); update_with always recomputes. Both filters see the
+  // same data, including a gap in dt that moves P off its steady state.
+  using Filter = Ekf<ConstantVelocity2<double>, PositionFix<4>>;
+  const PositionFix<4> fix = PositionFix<4>::isotropic(0.4);
+  Filter memo(ConstantVelocity2<double>(0.7), fix);
+  Filter plain(ConstantVelocity2<double>(0.7), fix);
+  memo.reset(Eigen::Vector4d::Zero(), Eigen::Matrix4d::Identity());
+  plain.reset(Eigen::Vector4d::Zero(), Eigen::Matrix4d::Identity());
+  std::mt19937 rng(11);
+  std::normal_distribution<double> n(0.0, 0.4);
+  for (int k = 0; k < 3000; ++k) {
+    const double dt = (k % 700 == 699) ? 0.5 : 0.1;
+    const Eigen::Vector2d z(0.3 * k + n(rng), -0.1 * k + n(rng));
+    REQUIRE(memo.predict(NoControl{}, dt) == FilterStatus::kApplied);
+    REQUIRE(plain.predict(NoControl{}, dt) == FilterStatus::kApplied);
+    const auto a = memo.update<0>(z);
+    const auto b = plain.update_with(fix, z);
+    REQUIRE(a.status == b.status);
+    REQUIRE(a.nis == b.nis);
+    REQUIRE(memo.state() == plain.state());
+    REQUIRE(memo.covariance() == plain.covariance());
+  }
 }

@@ -174,6 +174,19 @@ inline constexpr bool has_identity_jacobian_v = [] {
   }
 }();
 
+/// Measurement models whose Jacobian and noise depend neither on the state
+/// nor on time may say so with `static constexpr bool kTimeInvariant = true;`.
+/// The covariance part of their update is then a function of P alone, and
+/// estimators may reuse it while P repeats (a converged filter).
+template <class H>
+inline constexpr bool is_time_invariant_v = [] {
+  if constexpr (requires { H::kTimeInvariant; }) {
+    return bool(H::kTimeInvariant);
+  } else {
+    return false;
+  }
+}();
+
 /// Asserts each requirement of MotionModel separately, so that the compiler's
 /// message names the one that is missing. Use in a `static_assert` or call
 /// from a template that takes a motion model.

@@ -192,7 +192,23 @@ class Ekf {
   /// Update with the I-th measurement model of the filter.
   template <std::size_t I>
   [[nodiscard]] UpdateResult<SensorType<I>> update(const typename SensorType<I>::Measurement& z) {
-    return update_with(std::get<I>(sensors_), z, gates_[I]);
+    using H = SensorType<I>;
+    const H& sensor = std::get<I>(sensors_);
+    if constexpr (is_time_invariant_v<H>) {
+      // The covariance part depends on P alone: reuse it while P repeats
+      // (a converged, steady-state filter), bit for bit what it would compute.
+      GainMemo<H>& memo = std::get<I>(memos_);
+      if (!memo.valid || memo.P_in != P_) {
+        memo.valid = false;
+        const FilterStatus s = covariance_update(sensor, memo.gain);
+        if (s != FilterStatus::kApplied) return fail(UpdateResult<H>{}, s);
+        memo.P_in = P_;
+        memo.valid = true;
+      }
+      return apply_update(sensor, z, gates_[I], memo.gain);
+    } else {
+      return update_with(sensor, z, gates_[I]);
+    }
   }
 
   /// Update with the filter's measurement model of type H (which must occur
@@ -209,45 +225,10 @@ class Ekf {
   template <MeasurementModelFor<StateType> H>
   [[nodiscard]] UpdateResult<H> update_with(const H& sensor, const typename H::Measurement& z,
                                             Scalar gate = std::numeric_limits<Scalar>::infinity()) {
-    using Z = typename H::Measurement;
-    constexpr int ZDim = DimOf<Z>;
-    using SMat = CovarianceOf<Z>;
-    using Gain = Eigen::Matrix<Scalar, Dim, ZDim>;
-
-    UpdateResult<H> out;
-    out.innovation = minus(z, static_cast<Z>(sensor.predict(x_)));
-    if (!out.innovation.allFinite()) return out;  // kNonFinite
-    const SMat R = sensor.noise();
-    Gain K;
-    Covariance P_new;
-    SMat S_inv;
-    if constexpr (has_identity_jacobian_v<H> && ZDim == Dim) {
-      out.S = P_ + R;
-      if (!detail::spd_inverse(out.S, S_inv)) return fail(out, FilterStatus::kNotPositiveDefinite);
-      out.nis = out.innovation.dot(S_inv * out.innovation);
-      if (!(out.nis <= gate)) return fail(out, FilterStatus::kGated);
-      K = P_ * S_inv;
-      const Covariance I_K = Covariance::Identity() - K;
-      P_new = I_K * P_ * I_K.transpose() + K * R * K.transpose();
-    } else {
-      const MeasurementJacobianOf<H> J = sensor.jacobian(x_);
-      const Eigen::Matrix<Scalar, ZDim, Dim> JP = J * P_;
-      out.S = JP * J.transpose() + R;
-      if (!detail::spd_inverse(out.S, S_inv)) return fail(out, FilterStatus::kNotPositiveDefinite);
-      out.nis = out.innovation.dot(S_inv * out.innovation);
-      if (!(out.nis <= gate)) return fail(out, FilterStatus::kGated);
-      K = JP.transpose() * S_inv;  // K = P J^T S^-1
-      const Covariance I_KH = Covariance::Identity() - K * J;
-      P_new = I_KH * P_ * I_KH.transpose() + K * R * K.transpose();
-    }
-    const StateType x_new = plus(x_, TangentOf<StateType>(K * out.innovation));
-    if (!minus(x_new, x_).allFinite() || !P_new.allFinite()) {
-      return fail(out, FilterStatus::kNonFinite);
-    }
-    x_ = x_new;
-    P_ = symmetrised(P_new);
-    out.status = FilterStatus::kApplied;
-    return out;
+    Gain<H> g;
+    const FilterStatus s = covariance_update(sensor, g);
+    if (s != FilterStatus::kApplied) return fail(UpdateResult<H>{}, s);
+    return apply_update(sensor, z, gate, g);
   }
 
   /// Sets the NIS gate of the I-th measurement model; +infinity disables it.
@@ -275,6 +256,65 @@ class Ekf {
   }
 
  private:
+  /// The data-independent part of an update: S, S^-1, K and the Joseph-form
+  /// posterior covariance at the current P.
+  template <class H>
+  struct Gain {
+    using SMat = CovarianceOf<typename H::Measurement>;
+    SMat S;
+    SMat S_inv;
+    Eigen::Matrix<Scalar, Dim, DimOf<typename H::Measurement>> K;
+    Covariance P_post;
+  };
+  template <class H>
+  struct GainMemo {
+    bool valid = false;
+    Covariance P_in;
+    Gain<H> gain;
+  };
+
+  template <class H>
+  FilterStatus covariance_update(const H& sensor, Gain<H>& g) const {
+    using SMat = typename Gain<H>::SMat;
+    const SMat R = sensor.noise();
+    if constexpr (has_identity_jacobian_v<H> && DimOf<typename H::Measurement> == Dim) {
+      g.S = P_ + R;
+      if (!detail::spd_inverse(g.S, g.S_inv)) return FilterStatus::kNotPositiveDefinite;
+      g.K = P_ * g.S_inv;
+      const Covariance I_K = Covariance::Identity() - g.K;
+      g.P_post = I_K * P_ * I_K.transpose() + g.K * R * g.K.transpose();
+    } else {
+      const MeasurementJacobianOf<H> J = sensor.jacobian(x_);
+      const Eigen::Matrix<Scalar, DimOf<typename H::Measurement>, Dim> JP = J * P_;
+      g.S = JP * J.transpose() + R;
+      if (!detail::spd_inverse(g.S, g.S_inv)) return FilterStatus::kNotPositiveDefinite;
+      g.K = JP.transpose() * g.S_inv;  // K = P J^T S^-1
+      const Covariance I_KH = Covariance::Identity() - g.K * J;
+      g.P_post = I_KH * P_ * I_KH.transpose() + g.K * R * g.K.transpose();
+    }
+    if (!g.P_post.allFinite()) return FilterStatus::kNonFinite;
+    g.P_post = symmetrised(g.P_post);
+    return FilterStatus::kApplied;
+  }
+
+  template <class H>
+  UpdateResult<H> apply_update(const H& sensor, const typename H::Measurement& z, Scalar gate,
+                               const Gain<H>& g) {
+    using Z = typename H::Measurement;
+    UpdateResult<H> out;
+    out.S = g.S;
+    out.innovation = minus(z, static_cast<Z>(sensor.predict(x_)));
+    if (!out.innovation.allFinite()) return out;  // kNonFinite
+    out.nis = out.innovation.dot(g.S_inv * out.innovation);
+    if (!(out.nis <= gate)) return fail(out, FilterStatus::kGated);
+    const StateType x_new = plus(x_, TangentOf<StateType>(g.K * out.innovation));
+    if (!minus(x_new, x_).allFinite()) return fail(out, FilterStatus::kNonFinite);
+    x_ = x_new;
+    P_ = g.P_post;
+    out.status = FilterStatus::kApplied;
+    return out;
+  }
+
   template <class R>
   static R fail(R r, FilterStatus s) {
     r.status = s;
@@ -286,6 +326,7 @@ class Ekf {
 
   Motion motion_;
   std::tuple<Sensors...> sensors_;
+  std::tuple<GainMemo<Sensors>...> memos_;
   std::array<Scalar, sizeof...(Sensors) == 0 ? 1 : sizeof...(Sensors)> gates_{};
   StateType x_ = detail::zero_state<StateType>();
   Covariance P_ = Covariance::Identity();

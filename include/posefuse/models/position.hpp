@@ -23,6 +23,7 @@ class PositionFix {
   using Measurement = Eigen::Matrix<T, N, 1>;
   using Noise = Eigen::Matrix<T, N, N>;
   static constexpr bool kIdentityJacobian = (N == StateDim);  ///< H = I when square
+  static constexpr bool kTimeInvariant = true;  ///< H and Q depend on neither x nor time
 
   /// @param[in] Q measurement noise (m^2), the seed's Q
   /// @throws posefuse::invalid_argument unless Q is symmetric positive definite
