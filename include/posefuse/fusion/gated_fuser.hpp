@@ -5,37 +5,47 @@
 /// with Mahalanobis tests, averages angles on the circle, and **re-anchors**
 /// SLAM when it re-initialises in a new map frame instead of discarding it.
 ///
-/// **State.** \f$[x, y, \theta]\f$ of the body in the world (= odometry) frame,
-/// and \f$T_{wm} = [x, y, \theta]\f$, the pose of the current SLAM map frame
-/// in the world; 6x6 covariance. Both are PlanarPose (heading wraps).
+/// **State.** \f$x = [x, y, \theta]\f$ of the body in the world (=
+/// odometry) frame with a 3x3 covariance P, and \f$T_{wm}\f$, the pose of the
+/// current SLAM map frame in the world, estimated once per map (below).
 ///
 /// **Odometry (prediction).** Only increments are used:
-/// \f$\delta = O_{k-1}^{-1} \oplus O_k\f$, \f$x \leftarrow x \oplus \delta\f$, with
-/// body-frame noise \f$Q_\delta = \mathrm{diag}(k_{xy}^2 s, k_{xy}^2 s,
-/// k_{\theta s}^2 s + k_{\theta\theta}^2 |\Delta\theta|)\f$ (s = distance).
-/// The fused pose is therefore odometry *rebased onto the fused estimate*
-/// after every SLAM update — the same as resetting dead reckoning to the
-/// fused pose — so odometry drift does not keep accumulating into it.
+/// \f$\delta = O_{k-1}^{-1} \oplus O_k\f$, \f$x \leftarrow x \oplus \delta\f$,
+/// \f$P \leftarrow J_x P J_x^T + J_\delta Q_\delta J_\delta^T\f$ with body-frame
+/// noise \f$Q_\delta = \mathrm{diag}(k_{xy}^2 s, k_{xy}^2 s, k_{\theta s}^2 s +
+/// k_{\theta\theta}^2 |\Delta\theta|)\f$ (s = distance). The fused pose is
+/// therefore odometry *rebased onto the fused estimate* after every update —
+/// the same as resetting dead reckoning to it — so odometry drift does not
+/// keep accumulating into it.
 ///
-/// **SLAM (update).** \f$z = T_{wm}^{-1} \oplus x + v\f$, \f$v \sim N(0, R)\f$,
-/// an EKF update in Joseph form. With \f$H = I\f$ (anchor known) this is the
-/// information-weighted mean \f$(P^{-1} + R^{-1})^{-1}(P^{-1}x + R^{-1}z)\f$,
-/// with the heading residual wrapped, i.e. angle-aware averaging.
+/// **SLAM (update).** The SLAM pose is transformed into the world,
+/// \f$z_w = T_{wm} \oplus z\f$, and fused by information weighting
+/// (fuse_poses: \f$K = P(P+R)^{-1}\f$, \f$x \leftarrow x \boxplus K(z_w \boxminus
+/// x)\f$, Joseph form), the heading residual wrapped — angle-aware averaging.
 ///
-/// **Gates.** kSeparate: position \f$r_{xy}^T S_{xy}^{-1} r_{xy} \le \chi^2_2\f$
-/// *and* heading \f$r_\theta^2 / S_{\theta\theta} \le \chi^2_1\f$ — a large
-/// position disagreement is rejected even when the headings agree, unlike
-/// seed eq 14. kMahalanobis: \f$r^T S^{-1} r \le \chi^2_3\f$. kBoth: all three.
+/// **Gates** on \f$r = z_w \boxminus x\f$, \f$S = P + R\f$. kSeparate: position
+/// \f$r_{xy}^T S_{xy}^{-1} r_{xy} \le \chi^2_2\f$ *and* heading
+/// \f$r_\theta^2 / S_{\theta\theta} \le \chi^2_1\f$ — a large position
+/// disagreement is rejected even when the headings agree, unlike seed eq 14.
+/// kMahalanobis: \f$r^T S^{-1} r \le \chi^2_3\f$. kBoth: all three.
 ///
 /// **Re-anchoring.** At the first SLAM pose and at every `new_map_frame`
-/// (seed: ORB-SLAM re-initialised), the fuser collects the offsets
-/// \f$T_{wm,i} = x_i \oplus z_i^{-1}\f$ of the following SLAM poses against
-/// its own odometry-propagated pose, over at least `anchor_samples` poses and
-/// `anchor_min_travel_m` of travel; when they agree within tolerance (a
-/// frozen SLAM on a moving robot, or a jumping one, does not) their mean becomes
-/// \f$T_{wm}\f$, with covariance and cross-covariance from the Jacobians, and
-/// fusion resumes. After `reanchor_after_rejects` consecutive rejections the
-/// fuser assumes an unannounced map change and re-anchors the same way.
+/// (seed: ORB-SLAM re-initialised), the fuser pairs the following SLAM poses
+/// \f$z_i\f$ with its own odometry-propagated poses \f$x_i\f$, over at least
+/// `anchor_samples` poses and `anchor_min_travel_m` of travel: yaw = circular
+/// mean of \f$\theta_{x,i} - \theta_{z,i}\f$, translation = mean of
+/// \f$p_{x,i} - R(\mathrm{yaw})\,p_{z,i}\f$. When every pair then agrees at
+/// the robot, \f$x_i \approx T_{wm} \oplus z_i\f$ within tolerance (a frozen
+/// SLAM on a moving robot, or a jumping one, does not), the estimate becomes
+/// \f$T_{wm}\f$ and fusion resumes. After `reanchor_after_rejects`
+/// consecutive rejections the fuser assumes an unannounced map change and
+/// re-anchors the same way. The map frame is then held fixed: whatever error
+/// the pose had when it was anchored (drift while SLAM was unavailable) is
+/// not observable from SLAM and stays; anchor_covariance() reports it, and
+/// covariance() is relative to the anchored map. (An EKF that keeps
+/// \f$T_{wm}\f$ in its state was tried first: re-linearising at a lever arm of
+/// metres let it drift along that unobservable direction — the classic
+/// EKF-SLAM inconsistency — and it did worse on the corridor.)
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
@@ -125,7 +135,6 @@ struct GatedFuserParams {
   T odom_theta_sigma_per_sqrt_rad = T(0.03);   ///< heading noise per √rad turned (rad/√rad)
   T slam_xy_sigma_m = T(0.05);                 ///< SLAM position noise (m)
   T slam_theta_sigma_rad = T(0.02);            ///< SLAM heading noise (rad)
-  T anchor_drift_per_sqrt_m = T(0.005);        ///< SLAM map-frame drift per √m travelled (m, rad)
   GateMode gate = GateMode::kSeparate;         ///< which gates apply
   T gate_xy_chi2 = T(13.8155);                 ///< χ²₂ at 0.999
   T gate_theta_chi2 = T(10.8276);              ///< χ²₁ at 0.999 (also for update_heading)
@@ -163,20 +172,19 @@ class GatedFuser {
   using Pose = PlanarPose<T>;
   using Vec3 = Eigen::Matrix<T, 3, 1>;
   using Mat3 = Eigen::Matrix<T, 3, 3>;
-  using Mat6 = Eigen::Matrix<T, 6, 6>;
   using Input = GatedFuserInput<T>;
   using Output = GatedFuserOutput<T>;
   static constexpr int kMaxAnchorSamples = 32;
 
   /// @throws posefuse::invalid_argument for a negative or non-finite sigma, a
-  ///         non-positive gate, or anchor_samples / reanchor_after_rejects out of range
+  ///         non-positive gate or tolerance, or anchor_samples /
+  ///         reanchor_after_rejects out of range
   explicit GatedFuser(const GatedFuserParams<T>& p = {}) : p_(p) {
     const T s[] = {p.odom_xy_sigma_per_sqrt_m, p.odom_theta_sigma_per_sqrt_m,
-                   p.odom_theta_sigma_per_sqrt_rad, p.anchor_drift_per_sqrt_m};
+                   p.odom_theta_sigma_per_sqrt_rad, p.anchor_min_travel_m};
     for (T v : s)
-      if (!std::isfinite(v) || v < 0) throw invalid_argument("GatedFuser: sigma must be >= 0");
-    if (!std::isfinite(p.anchor_min_travel_m) || p.anchor_min_travel_m < 0)
-      throw invalid_argument("GatedFuser: anchor_min_travel_m must be >= 0");
+      if (!std::isfinite(v) || v < 0)
+        throw invalid_argument("GatedFuser: odometry sigmas and anchor_min_travel_m must be >= 0");
     const T q[] = {p.slam_xy_sigma_m, p.slam_theta_sigma_rad, p.gate_xy_chi2, p.gate_theta_chi2,
                    p.gate_joint_chi2, p.anchor_tol_xy_m, p.anchor_tol_theta_rad};
     for (T v : q)
@@ -186,6 +194,8 @@ class GatedFuser {
       throw invalid_argument("GatedFuser: anchor_samples must lie in [1, 32]");
     if (p.reanchor_after_rejects < 1)
       throw invalid_argument("GatedFuser: reanchor_after_rejects must be >= 1");
+    const T sxy = p.slam_xy_sigma_m, sth = p.slam_theta_sigma_rad;
+    R_ = Vec3(sxy * sxy, sxy * sxy, sth * sth).asDiagonal();
     reset(Pose{}, Mat3::Identity() * T(1e-6));
   }
 
@@ -194,8 +204,8 @@ class GatedFuser {
   void reset(const Pose& start, const Mat3& cov) noexcept {
     x_ = start;
     a_ = Pose{};
-    P_.setIdentity();
-    P_.template topLeftCorner<3, 3>() = cov;
+    P_ = cov;
+    Pa_.setZero();
     have_odom_ = false;
     anchor_ = AnchorState::kNone;
     n_cand_ = 0;
@@ -228,14 +238,7 @@ class GatedFuser {
     const Vec3 q(kxy * kxy * ds, kxy * kxy * ds, kts * kts * ds + ktt * ktt * dth);
     x_ = se2_compose(x_, d);
     travelled_ += ds;
-    const Mat3 Pxx = P_.template topLeftCorner<3, 3>();
-    P_.template topLeftCorner<3, 3>() = Jx * Pxx * Jx.transpose() + Jd * q.asDiagonal() * Jd.transpose();
-    const Mat3 Pxa = Jx * P_.template topRightCorner<3, 3>();
-    P_.template topRightCorner<3, 3>() = Pxa;
-    P_.template bottomLeftCorner<3, 3>() = Pxa.transpose();
-    if (anchor_ == AnchorState::kAnchored)
-      P_.template bottomRightCorner<3, 3>().diagonal().array() +=
-          p_.anchor_drift_per_sqrt_m * p_.anchor_drift_per_sqrt_m * ds;
+    P_ = Jx * P_ * Jx.transpose() + Jd * q.asDiagonal() * Jd.transpose();
     return FuserStatus::kPredicted;
   }
 
@@ -250,22 +253,9 @@ class GatedFuser {
       return FuserStatus::kNonFinite;
     if (new_map_frame || anchor_ == AnchorState::kNone) start_anchoring();
     if (anchor_ == AnchorState::kCollecting) return collect(z);
-    // h(x, a) = a^-1 (+) x;  r = z (-) h
-    const T ca = std::cos(a_.theta), sa = std::sin(a_.theta);
-    Eigen::Matrix<T, 2, 2> Rt;
-    Rt << ca, sa, -sa, ca;  // R(-a.theta)
-    const Eigen::Matrix<T, 2, 1> dxy(x_.x - a_.x, x_.y - a_.y);
-    const Eigen::Matrix<T, 2, 1> hxy = Rt * dxy;
-    const Vec3 r(z.x - hxy(0), z.y - hxy(1), angle_diff(z.theta, wrap_angle(x_.theta - a_.theta)));
-    Eigen::Matrix<T, 3, 6> H = Eigen::Matrix<T, 3, 6>::Zero();
-    H.template block<2, 2>(0, 0) = Rt;
-    H(2, 2) = 1;
-    H.template block<2, 2>(0, 3) = -Rt;
-    H.template block<2, 1>(0, 5) = -Rt * Eigen::Matrix<T, 2, 1>(-dxy(1), dxy(0));
-    H(2, 5) = -1;
-    const T sxy = p_.slam_xy_sigma_m, sth = p_.slam_theta_sigma_rad;
-    const Vec3 Rd(sxy * sxy, sxy * sxy, sth * sth);
-    const Mat3 S = H * P_ * H.transpose() + Mat3(Rd.asDiagonal());
+    const Pose zw = se2_compose(a_, z);  // SLAM pose in the world
+    const Vec3 r = zw.minus(x_);
+    const Mat3 S = P_ + R_;  // R is isotropic in x, y: the same in any frame
     const Eigen::LDLT<Mat3> ldlt(S);
     if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return FuserStatus::kSingularInnovation;
     const FuserStatus g = gate(r, S, ldlt);
@@ -274,7 +264,10 @@ class GatedFuser {
       return g;
     }
     rejects_ = 0;
-    apply<3>(r, H, S, Mat3(Rd.asDiagonal()));
+    const Mat3 K = ldlt.solve(P_).transpose();  // P (P + R)^-1
+    const Mat3 IK = Mat3::Identity() - K;
+    x_ = x_.plus(K * r);
+    P_ = IK * P_ * IK.transpose() + K * R_ * K.transpose();
     return FuserStatus::kFused;
   }
 
@@ -284,13 +277,14 @@ class GatedFuser {
   /// @param[in] sigma its 1-σ noise (rad, > 0)
   [[nodiscard]] FuserStatus update_heading(T yaw, T sigma) noexcept {
     if (!std::isfinite(yaw) || !std::isfinite(sigma) || !(sigma > 0)) return FuserStatus::kNonFinite;
-    Eigen::Matrix<T, 1, 6> H = Eigen::Matrix<T, 1, 6>::Zero();
-    H(0, 2) = 1;
-    const Eigen::Matrix<T, 1, 1> R(sigma * sigma), r(angle_diff(yaw, x_.theta));
-    const Eigen::Matrix<T, 1, 1> S = H * P_ * H.transpose() + R;
-    if (!(S(0, 0) > 0)) return FuserStatus::kSingularInnovation;
-    if (r(0) * r(0) > p_.gate_theta_chi2 * S(0, 0)) return FuserStatus::kRejectedHeading;
-    apply<1>(r, H, S, R);
+    const T r = angle_diff(yaw, x_.theta), S = P_(2, 2) + sigma * sigma;
+    if (!(S > 0)) return FuserStatus::kSingularInnovation;
+    if (r * r > p_.gate_theta_chi2 * S) return FuserStatus::kRejectedHeading;
+    const Vec3 K = P_.col(2) / S;
+    Mat3 IKH = Mat3::Identity();
+    IKH.col(2) -= K;
+    x_ = x_.plus(K * r);
+    P_ = IKH * P_ * IKH.transpose() + (sigma * sigma) * K * K.transpose();
     return FuserStatus::kFused;
   }
 
@@ -301,16 +295,17 @@ class GatedFuser {
     if (in.has_slam && out.slam_status == FuserStatus::kPredicted)
       out.slam_status = update_slam(in.slam, in.slam_new_map_frame);
     out.pose = x_;
-    out.cov = covariance();
+    out.cov = P_;
     return out;
   }
 
   /// Fused body pose in the world frame.
   [[nodiscard]] const Pose& pose() const noexcept { return x_; }
-  /// Its 3x3 covariance.
-  [[nodiscard]] Mat3 covariance() const noexcept { return P_.template topLeftCorner<3, 3>(); }
-  /// The full 6x6 covariance of [pose, map frame].
-  [[nodiscard]] const Mat6& joint_covariance() const noexcept { return P_; }
+  /// Its covariance, relative to the anchored SLAM map once one is anchored.
+  [[nodiscard]] const Mat3& covariance() const noexcept { return P_; }
+  /// Covariance of the pose when the current map was anchored (the part of
+  /// the error that SLAM cannot remove); zero before the first anchor.
+  [[nodiscard]] const Mat3& anchor_covariance() const noexcept { return Pa_; }
   /// True when a SLAM map frame is anchored (SLAM poses are being fused).
   [[nodiscard]] bool anchored() const noexcept { return anchor_ == AnchorState::kAnchored; }
   /// \f$T_{wm}\f$: the current SLAM map frame in the world (valid when anchored()).
@@ -326,6 +321,11 @@ class GatedFuser {
 
  private:
   enum class AnchorState { kNone, kCollecting, kAnchored };
+  struct Candidate {
+    Pose x;  // fused (odometry-propagated) pose when the SLAM pose arrived
+    Pose z;  // the SLAM pose, map frame
+    T s;     // odometry distance travelled by then (m)
+  };
 
   void start_anchoring() noexcept {
     anchor_ = AnchorState::kCollecting;
@@ -345,31 +345,14 @@ class GatedFuser {
     return FuserStatus::kFused;
   }
 
-  template <int M>
-  void apply(const Eigen::Matrix<T, M, 1>& r, const Eigen::Matrix<T, M, 6>& H,
-             const Eigen::Matrix<T, M, M>& S, const Eigen::Matrix<T, M, M>& R) noexcept {
-    Eigen::Matrix<T, 6, M> K;
-    if constexpr (M == 1) {
-      K = (P_ * H.transpose()) / S(0, 0);  // scalar innovation: no factorisation
-    } else {
-      K = S.ldlt().solve(H * P_).transpose();  // P H^T S^-1
-    }
-    const Eigen::Matrix<T, 6, 1> dx = K * r;
-    x_ = x_.plus(dx.template head<3>());
-    if (anchor_ == AnchorState::kAnchored) a_ = a_.plus(dx.template tail<3>());
-    const Mat6 IKH = Mat6::Identity() - K * H;
-    P_ = IKH * P_ * IKH.transpose() + K * R * K.transpose();
-    P_ = T(0.5) * (P_ + P_.transpose()).eval();
-  }
-
   FuserStatus collect(const Pose& z) noexcept {
     if (n_cand_ == kMaxAnchorSamples) {  // drop the oldest
       for (int i = 1; i < n_cand_; ++i) cand_[std::size_t(i - 1)] = cand_[std::size_t(i)];
       --n_cand_;
     }
-    cand_[std::size_t(n_cand_++)] = {se2_compose(x_, se2_inverse(z)), travelled_};  // T_wm candidate
+    cand_[std::size_t(n_cand_++)] = {x_, z, travelled_};
     if (n_cand_ < p_.anchor_samples) return FuserStatus::kAnchoring;
-    // The window: the newest anchor_samples candidates, widened until it spans
+    // The window: the newest anchor_samples pairs, widened until it spans
     // anchor_min_travel_m of odometry (unless the buffer is full).
     const T s_new = cand_[std::size_t(n_cand_ - 1)].s;
     int first = n_cand_ - p_.anchor_samples;
@@ -377,41 +360,31 @@ class GatedFuser {
     if (s_new - cand_[std::size_t(first)].s < p_.anchor_min_travel_m && n_cand_ < kMaxAnchorSamples)
       return FuserStatus::kAnchoring;
     const int N = n_cand_ - first;
-    T sx = 0, sy = 0, ss = 0, sc = 0;
+    // Yaw from the headings (so a short window suffices), then translation.
+    T ss = 0, sc = 0;
     for (int i = first; i < n_cand_; ++i) {
-      const Pose& c = cand_[std::size_t(i)].a;
-      sx += c.x;
-      sy += c.y;
-      ss += std::sin(c.theta);
-      sc += std::cos(c.theta);
+      const Candidate& c = cand_[std::size_t(i)];
+      ss += std::sin(c.x.theta - c.z.theta);
+      sc += std::cos(c.x.theta - c.z.theta);
     }
-    const Pose mean{sx / T(N), sy / T(N), std::atan2(ss, sc)};
+    const Pose rot{0, 0, std::atan2(ss, sc)};
+    Pose mean = rot;
     for (int i = first; i < n_cand_; ++i) {
-      const Pose& c = cand_[std::size_t(i)].a;
-      if (std::hypot(c.x - mean.x, c.y - mean.y) > p_.anchor_tol_xy_m ||
-          std::abs(angle_diff(c.theta, mean.theta)) > p_.anchor_tol_theta_rad)
+      const Candidate& c = cand_[std::size_t(i)];
+      const Pose r = se2_compose(rot, c.z);
+      mean.x += (c.x.x - r.x) / T(N);
+      mean.y += (c.x.y - r.y) / T(N);
+    }
+    // Consistency, checked at the robot (free of the lever arm to the map
+    // origin): every pair must satisfy x_i ~ mean (+) z_i.
+    for (int i = first; i < n_cand_; ++i) {
+      const Candidate& c = cand_[std::size_t(i)];
+      const Vec3 e = c.x.minus(se2_compose(mean, c.z));
+      if (std::hypot(e(0), e(1)) > p_.anchor_tol_xy_m || std::abs(e(2)) > p_.anchor_tol_theta_rad)
         return FuserStatus::kAnchoring;  // inconsistent (frozen, jumping): keep collecting
     }
-    // a = x (+) z^-1; covariance from P_xx and R / N via the Jacobians.
     a_ = mean;
-    const Eigen::Matrix<T, 2, 1> ax(a_.x - x_.x, a_.y - x_.y);
-    Mat3 Jax = Mat3::Identity();
-    Jax(0, 2) = -ax(1);
-    Jax(1, 2) = ax(0);
-    const T c = std::cos(a_.theta), s = std::sin(a_.theta);
-    Mat3 Jaz = Mat3::Zero();
-    Jaz.template topLeftCorner<2, 2>() << -c, s, -s, -c;
-    Jaz(0, 2) = ax(1);
-    Jaz(1, 2) = -ax(0);
-    Jaz(2, 2) = -1;
-    const T sxy = p_.slam_xy_sigma_m, sth = p_.slam_theta_sigma_rad;
-    const Vec3 Rd(sxy * sxy, sxy * sxy, sth * sth);
-    const Mat3 Pxx = P_.template topLeftCorner<3, 3>();
-    const Mat3 Pax = Jax * Pxx;
-    P_.template bottomRightCorner<3, 3>() =
-        Pax * Jax.transpose() + Jaz * (Rd / T(N)).asDiagonal() * Jaz.transpose();
-    P_.template bottomLeftCorner<3, 3>() = Pax;
-    P_.template topRightCorner<3, 3>() = Pax.transpose();
+    Pa_ = P_;
     anchor_ = AnchorState::kAnchored;
     ++anchors_;
     return FuserStatus::kAnchored;
@@ -419,13 +392,9 @@ class GatedFuser {
 
   GatedFuserParams<T> p_;
   Pose x_{}, a_{}, odom_{};
-  Mat6 P_ = Mat6::Identity();
+  Mat3 P_ = Mat3::Identity(), Pa_ = Mat3::Zero(), R_ = Mat3::Identity();
   bool have_odom_ = false;
   AnchorState anchor_ = AnchorState::kNone;
-  struct Candidate {
-    Pose a;  // x (+) z^-1
-    T s;     // odometry distance travelled when it was taken (m)
-  };
   std::array<Candidate, kMaxAnchorSamples> cand_{};
   T travelled_ = 0;
   int n_cand_ = 0, rejects_ = 0, anchors_ = 0;
