@@ -1,0 +1,142 @@
+// The corridor simulation: geometry, determinism, sensor models, SLAM failure.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <set>
+#include <posefuse/sim/corridor.hpp>
+
+using posefuse::CorridorSimConfig;
+using posefuse::SlamState;
+using posefuse::simulate_corridor;
+
+namespace {
+const posefuse::CorridorSimulation& sim1() {
+  static const auto s = simulate_corridor({}, 1);
+  return s;
+}
+double t_of(const CorridorSimConfig& c, std::int64_t t_ns) { return double(t_ns - c.t0_ns) * 1e-9; }
+}  // namespace
+
+TEST_CASE("Corridor sim: the same seed gives the same log, another seed another", "[sim]") {
+  const auto a = simulate_corridor({}, 7);
+  const auto b = simulate_corridor({}, 7);
+  const auto c = simulate_corridor({}, 8);
+  CHECK(a.log == b.log);
+  CHECK_FALSE(a.log == c.log);
+}
+
+TEST_CASE("Corridor sim: 14 m x 9 m counter-clockwise loop back to the start", "[sim]") {
+  const auto& s = sim1();
+  const auto& gt = s.log.groundtruth;
+  REQUIRE(gt.size() > 1000);
+  CHECK(gt.front().x == 0.0);
+  CHECK(gt.front().yaw == 0.0);
+  CHECK(std::abs(gt.back().x) < 1e-9);
+  CHECK(std::abs(gt.back().y) < 1e-9);
+  CHECK(std::abs(gt.back().yaw) < 1e-9);
+  // Corners at the end of each leg: 2 = (14, 0), 3 = (14, 9), 4 = (0, 9).
+  REQUIRE(s.manoeuvres.size() == 8);
+  const double corners[3][2] = {{14, 0}, {14, 9}, {0, 9}};
+  for (int k = 0; k < 3; ++k) {
+    const double t = s.manoeuvres[std::size_t(2 * k)].t_end_s;
+    const auto it = std::lower_bound(gt.begin(), gt.end(), t, [&](const auto& g, double v) {
+      return t_of(CorridorSimConfig{}, g.t_ns) < v;
+    });
+    REQUIRE(it != gt.end());
+    CHECK(it->x == Approx(corners[k][0]).margin(1e-3));
+    CHECK(it->y == Approx(corners[k][1]).margin(1e-3));
+  }
+  // Counter-clockwise: every turn is +90°, and x, y stay inside the rectangle.
+  for (const auto& m : s.manoeuvres) CHECK(m.t_end_s > m.t_start_s);
+  for (const auto& g : gt) {
+    CHECK(g.x > -1e-6);
+    CHECK(g.x < 14 + 1e-6);
+    CHECK(g.y > -1e-6);
+    CHECK(g.y < 9 + 1e-6);
+  }
+}
+
+TEST_CASE("Corridor sim: asynchronous streams with strictly increasing, unshared stamps", "[sim]") {
+  const auto& L = sim1().log;
+  std::set<std::int64_t> wheel_t, imu_t;
+  for (std::size_t i = 1; i < L.wheels.size(); ++i) CHECK(L.wheels[i].t_ns > L.wheels[i - 1].t_ns);
+  for (std::size_t i = 1; i < L.imu.size(); ++i) CHECK(L.imu[i].t_ns > L.imu[i - 1].t_ns);
+  for (std::size_t i = 1; i < L.slam.size(); ++i) CHECK(L.slam[i].t_ns > L.slam[i - 1].t_ns);
+  for (const auto& w : L.wheels) wheel_t.insert(w.t_ns);
+  for (const auto& m : L.imu) imu_t.insert(m.t_ns);
+  int shared = 0;
+  for (const auto& sl : L.slam) shared += int(wheel_t.count(sl.t_ns) + imu_t.count(sl.t_ns));
+  for (const auto& m : L.imu) shared += int(wheel_t.count(m.t_ns));
+  CHECK(shared == 0);
+  // Rates: about 50, 100 and 15 Hz over the run.
+  const double T = sim1().duration_s;
+  CHECK(double(L.wheels.size()) / T == Approx(50).epsilon(0.02));
+  CHECK(double(L.imu.size()) / T == Approx(100).epsilon(0.02));
+  CHECK(double(L.slam.size()) / T == Approx(15).epsilon(0.02));
+}
+
+TEST_CASE("Corridor sim: encoders count a full turn; the IMU reads gravity and a field", "[sim]") {
+  const auto& s = sim1();
+  const CorridorSimConfig c;
+  const auto& w = s.log.wheels.back();
+  const double m_per_tick = 2 * std::numbers::pi * c.wheel_radius_m / c.ticks_per_rev;
+  const double left = 0.5 * double(w.fl + w.bl) * m_per_tick;
+  const double right = 0.5 * double(w.fr + w.br) * m_per_tick;
+  CHECK(0.5 * (left + right) == Approx(46.0).epsilon(0.01));  // 2 x (14 + 9) m
+  // Heading from the encoders: 2π, off by the effective-track error (1.5 %
+  // + N(0, 1 %) per turn) and the wheel-radius errors on the straights.
+  const double heading = (right - left) / c.track_width_m;
+  CHECK(heading > 2 * std::numbers::pi);
+  CHECK(heading < 2 * std::numbers::pi * 1.06);
+  // At rest (first second): specific force ~ (0, 0, 9.81), gyro ~ bias.
+  double az = 0, gz = 0, mnorm = 0;
+  int n = 0;
+  for (const auto& m : s.log.imu) {
+    if (t_of(c, m.t_ns) > 1.0) break;
+    az += m.accel_mps2[2];
+    gz += m.gyro_radps[2];
+    mnorm += std::hypot(m.mag_uT[0], m.mag_uT[1], m.mag_uT[2]);
+    ++n;
+  }
+  CHECK(az / n == Approx(9.81).margin(0.2));
+  CHECK(std::abs(gz / n) < 0.015);
+  CHECK(mnorm / n > 25);
+  CHECK(mnorm / n < 90);
+}
+
+TEST_CASE("Corridor sim: SLAM freezes before corner 3, is lost, and re-initialises later",
+          "[sim]") {
+  const auto& s = sim1();
+  const CorridorSimConfig c;
+  CHECK(s.t_freeze_s < s.manoeuvres[3].t_start_s);  // before the turn at corner 3
+  CHECK(s.t_lost_s > s.t_freeze_s);
+  CHECK(s.t_reinit_s > s.manoeuvres[3].t_end_s);     // after it
+  int reinit = 0, lost_after_freeze = 0, frozen = 0;
+  double fx = 0, fy = 0;
+  for (const auto& r : s.log.slam) {
+    const double t = t_of(c, r.t_ns);
+    reinit += r.state == SlamState::kReinit;
+    if (t >= s.t_lost_s && t < s.t_reinit_s) lost_after_freeze += r.state == SlamState::kLost;
+    if (t >= s.t_lost_s && t < s.t_reinit_s) CHECK(r.state == SlamState::kLost);
+    if (t >= s.t_freeze_s && t < s.t_lost_s) {
+      CHECK(r.state == SlamState::kTracking);
+      if (frozen++ == 0) {
+        fx = r.p[0];
+        fy = r.p[1];
+      }
+      CHECK(std::hypot(r.p[0] - fx, r.p[1] - fy) < 0.25);  // stuck, up to noise
+    }
+    if (t >= s.t_reinit_s) CHECK(r.state != SlamState::kLost);
+  }
+  CHECK(reinit == 1);
+  CHECK(frozen > 30);
+  CHECK(lost_after_freeze > 100);
+  // The reinit pose is expressed in a new frame: far from the world pose.
+  const auto it = std::find_if(s.log.slam.begin(), s.log.slam.end(),
+                               [](const auto& r) { return r.state == SlamState::kReinit; });
+  REQUIRE(it != s.log.slam.end());
+  const double q = std::hypot(it->q[0], it->q[1], it->q[2]);
+  CHECK(std::hypot(q, it->q[3]) == Approx(1.0));
+}

@@ -1,0 +1,177 @@
+// The recorded-log folder format (issue 3 item 7): round trip through the
+// simulator, and file:line errors for malformed input.
+#include <catch2/catch.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <unistd.h>
+#include <posefuse/io/robot_log.hpp>
+#include <posefuse/sim/corridor.hpp>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// A scratch folder removed at the end of the test.
+class Scratch {
+ public:
+  Scratch() {
+    static std::atomic<int> n{0};
+    path_ = fs::temp_directory_path() /
+            ("posefuse-robotlog-" + std::to_string(::getpid()) + "-" + std::to_string(n++) + "-" +
+             std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()));
+    fs::create_directories(path_);
+  }
+  ~Scratch() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  Scratch(const Scratch&) = delete;
+  Scratch& operator=(const Scratch&) = delete;
+  const fs::path& path() const { return path_; }
+  void write(const std::string& name, const std::string& text) const {
+    std::ofstream(path_ / name, std::ios::binary) << text;
+  }
+
+ private:
+  fs::path path_;
+};
+
+const char* kRobot =
+    "# robot\nticks_per_rev 1320\nwheel_radius_m 0.065\ntrack_width_m 0.4\n"
+    "complementary_alpha 0.98\nfuser_threshold 0.01\n";
+const char* kWheels = "# t_ns,fl,fr,bl,br\n100,0,0,0,0\n200,5,6,5,6\n300,10,12,10,12\n";
+const char* kImu = "# t_ns,ax,ay,az,gx,gy,gz,mx,my,mz\n150,0,0,9.81,0,0,0,30,0,-40\n";
+const char* kSlam = "# t_ns,state,x,y,z,qx,qy,qz,qw\n120,lost,0,0,0,0,0,0,1\n220,tracking,0.1,0,0,0,0,0,1\n";
+
+// A valid minimal log in `d`, then `name` replaced by `text`.
+void minimal_log(const Scratch& d, const std::string& name = "", const std::string& text = "") {
+  d.write("robot.txt", kRobot);
+  d.write("wheels.csv", kWheels);
+  d.write("imu.csv", kImu);
+  d.write("slam.csv", kSlam);
+  if (!name.empty()) d.write(name, text);
+}
+
+// The message of the io_error read_robot_log throws.
+std::string error_of(const Scratch& d) {
+  try {
+    (void)posefuse::read_robot_log(d.path());
+  } catch (const posefuse::io_error& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+}  // namespace
+
+TEST_CASE("RobotLog: a minimal log reads back with every field", "[sim][io][robot_log]") {
+  Scratch d;
+  minimal_log(d);
+  const auto log = posefuse::read_robot_log(d.path());
+  CHECK(log.params.ticks_per_rev == 1320);
+  CHECK(log.params.track_width_m == 0.4);
+  REQUIRE(log.wheels.size() == 3);
+  CHECK(log.wheels[2].fr == 12);
+  REQUIRE(log.imu.size() == 1);
+  CHECK(log.imu[0].mag_uT[2] == -40);
+  REQUIRE(log.slam.size() == 2);
+  CHECK(log.slam[0].state == posefuse::SlamState::kLost);
+  CHECK(log.slam[1].p[0] == 0.1);
+  CHECK(log.groundtruth.empty());
+}
+
+TEST_CASE("RobotLog: the simulator's log round-trips bit-identically", "[sim][io][robot_log]") {
+  Scratch d;
+  const auto sim = posefuse::simulate_corridor({}, 3);
+  posefuse::write_robot_log(d.path(), sim.log);
+  for (const char* f : {"robot.txt", "wheels.csv", "imu.csv", "slam.csv", "groundtruth.csv"})
+    CHECK(fs::is_regular_file(d.path() / f));
+  const auto back = posefuse::read_robot_log(d.path());
+  CHECK(back == sim.log);
+  // Without ground truth the file is not written (and a stale one is removed).
+  auto no_gt = sim.log;
+  no_gt.groundtruth.clear();
+  posefuse::write_robot_log(d.path(), no_gt);
+  CHECK_FALSE(fs::exists(d.path() / "groundtruth.csv"));
+  CHECK(posefuse::read_robot_log(d.path()) == no_gt);
+}
+
+TEST_CASE("RobotLog: liberal about headers, spaces, CRLF, case and lost rows", "[sim][io][robot_log]") {
+  Scratch d;
+  minimal_log(d, "slam.csv",
+              "t_ns,state,x,y,z,qx,qy,qz,qw\r\n"  // uncommented column names
+              "\r\n"
+              "120 , LOST , nan,nan,nan,nan,nan,nan,nan\r\n"  // lost poses may be NaN
+              "130,lost,,,,,,,\r\n"                            // ... or empty
+              "220,Tracking, 0.1 ,0,0,0,0,0,1\r\n"
+              "320,reinit,+5,0,0,0,0,0.7071068,0.7071068\r\n");
+  d.write("robot.txt", std::string(kRobot) + "# trailing comment\n");
+  const auto log = posefuse::read_robot_log(d.path());
+  REQUIRE(log.slam.size() == 4);
+  CHECK(log.slam[2].state == posefuse::SlamState::kTracking);
+  CHECK(log.slam[3].state == posefuse::SlamState::kReinit);
+  CHECK(log.slam[3].p[0] == 5.0);
+}
+
+TEST_CASE("RobotLog: malformed files name file and line", "[sim][io][robot_log]") {
+  struct Case {
+    const char* file;
+    const char* text;
+    const char* where;  // "<file>:<line>"
+    const char* what;   // part of the reason
+  };
+  const Case cases[] = {
+      {"wheels.csv", "# h\n100,0,0,0,0\n200,1,2,3\n", "wheels.csv:3", "expected 5 columns"},
+      {"wheels.csv", "100,0,0,0,0\n200,1,x,3,4\n", "wheels.csv:2", "column 'fr' is not an integer"},
+      {"wheels.csv", "100,0,0,0,0\n100,1,1,1,1\n", "wheels.csv:2", "does not increase"},
+      {"wheels.csv", "100,0,0,0,0\n200,1,1,1,1\n150,2,2,2,2\n", "wheels.csv:3", "does not increase"},
+      {"imu.csv", "# h\n\n150,0,0,nan,0,0,0,30,0,-40\n", "imu.csv:3", "column 'az' is not finite"},
+      {"imu.csv", "150,0,0,9.8,0,0,0,30,0,inf\n", "imu.csv:1", "column 'mz' is not finite"},
+      {"imu.csv", "150,0,0,9.8,0,0,0,30,0,-40,7\n", "imu.csv:1", "expected 10 columns"},
+      {"imu.csv", "150,0,0,9.8,0,0,0,30,0,1e999\n", "imu.csv:1", "column 'mz' is not a number"},
+      {"slam.csv", "120,lost,0,0,0,0,0,0,1\n220,flying,0,0,0,0,0,0,1\n", "slam.csv:2",
+       "column 'state' is not tracking, lost or reinit"},
+      {"slam.csv", "220,tracking,0,0,0,0,0,0,2\n", "slam.csv:1", "not unit length"},
+      {"slam.csv", "220,tracking,nan,0,0,0,0,0,1\n", "slam.csv:1", "column 'x' is not finite"},
+      {"groundtruth.csv", "0,0,0,0\n10,1,2\n", "groundtruth.csv:2", "expected 4 columns"},
+      {"robot.txt", "ticks_per_rev 1320\nwheel_radius_m -0.065\n", "robot.txt:2",
+       "must be positive"},
+      {"robot.txt", "ticks_per_rev 1320\nwheel_diameter_m 0.13\n", "robot.txt:2", "unknown key"},
+      {"robot.txt", "ticks_per_rev 1320\nticks_per_rev 1000\n", "robot.txt:2", "duplicate key"},
+      {"robot.txt", "ticks_per_rev abc\n", "robot.txt:1", "not a number"},
+      {"robot.txt", "ticks_per_rev\n", "robot.txt:1", "expected 'key value'"},
+      {"robot.txt",
+       "ticks_per_rev 1320\nwheel_radius_m 0.065\ntrack_width_m 0.4\ncomplementary_alpha 1.5\n",
+       "robot.txt:4", "(0, 1)"},
+  };
+  for (const auto& c : cases) {
+    Scratch d;
+    minimal_log(d, c.file, c.text);
+    const std::string msg = error_of(d);
+    INFO(c.file << ": " << msg);
+    CHECK(msg.find(std::string(c.where) + ": ") != std::string::npos);
+    CHECK(msg.find(c.what) != std::string::npos);
+  }
+}
+
+TEST_CASE("RobotLog: missing files and keys are reported", "[sim][io][robot_log]") {
+  for (const char* f : {"robot.txt", "wheels.csv", "imu.csv", "slam.csv"}) {
+    Scratch d;
+    minimal_log(d);
+    fs::remove(d.path() / f);
+    const std::string msg = error_of(d);
+    INFO(msg);
+    CHECK(msg.find(std::string(f) + ": required file is missing") != std::string::npos);
+  }
+  Scratch d;
+  minimal_log(d, "robot.txt", "ticks_per_rev 1320\nwheel_radius_m 0.065\ntrack_width_m 0.4\n"
+                              "complementary_alpha 0.98\n");
+  CHECK(error_of(d).find("robot.txt: missing required key 'fuser_threshold'") != std::string::npos);
+  minimal_log(d, "wheels.csv", "# only one row\n100,0,0,0,0\n");
+  CHECK(error_of(d).find("wheels.csv: needs at least two data rows") != std::string::npos);
+  CHECK_THROWS_AS(posefuse::read_robot_log(d.path() / "nope"), posefuse::io_error);
+}
