@@ -1,0 +1,153 @@
+// Seed 001's corridor experiment end to end: the four methods on simulated
+// and written-then-read logs, asynchronous streams, missing ground truth.
+#include <catch2/catch.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <unistd.h>
+#include <posefuse/fusion/corridor_runner.hpp>
+#include <posefuse/io/robot_log.hpp>
+#include <posefuse/sim/corridor.hpp>
+
+namespace fs = std::filesystem;
+using posefuse::CorridorMethod;
+
+namespace {
+
+constexpr std::size_t kSlam = std::size_t(CorridorMethod::kSlamOnly);
+constexpr std::size_t kOdom = std::size_t(CorridorMethod::kOdometryOnly);
+constexpr std::size_t kSeed = std::size_t(CorridorMethod::kSeedFuser);
+constexpr std::size_t kGated = std::size_t(CorridorMethod::kGatedFuser);
+
+fs::path scratch_dir() {
+  static std::atomic<int> n{0};
+  const fs::path p = fs::temp_directory_path() /
+                     ("posefuse-corridor-" + std::to_string(::getpid()) + "-" + std::to_string(n++) +
+                      "-" + std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()));
+  fs::create_directories(p);
+  return p;
+}
+
+bool same(double a, double b) { return (std::isnan(a) && std::isnan(b)) || a == b; }
+
+}  // namespace
+
+TEST_CASE("Corridor: SLAM alone fails at corner 3; the gated fuser completes the loop",
+          "[fusion][corridor]") {
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    const auto sim = posefuse::simulate_corridor({}, seed);
+    const auto r = posefuse::run_corridor(sim.log);
+    const auto& m = r.metrics;
+    INFO("seed " << seed << ": loop closure slam " << m[kSlam].loop_closure_error_m << ", odom "
+                 << m[kOdom].loop_closure_error_m << ", seed fuser " << m[kSeed].loop_closure_error_m
+                 << ", gated " << m[kGated].loop_closure_error_m);
+    // SLAM alone: ~14 s without a pose from corner 3 on, then a wrong frame.
+    CHECK(m[kSlam].time_without_pose_s > 10.0);
+    CHECK(m[kSlam].loop_closure_error_m > 1.5);
+    CHECK(std::isnan(m[kSlam].yaw_error_after_turn_deg.at(1)));  // lost during turn 2
+    // The fusers always have a pose.
+    CHECK(m[kGated].time_without_pose_s == 0.0);
+    CHECK(m[kSeed].time_without_pose_s == 0.0);
+    // The gated fuser closes the loop, better than odometry alone; what is
+    // left is the heading drift while SLAM was lost, which SLAM cannot see.
+    CHECK(m[kGated].loop_closure_error_m < 1.0);
+    CHECK(m[kGated].loop_closure_error_m < m[kOdom].loop_closure_error_m);
+    CHECK(m[kGated].loop_closure_error_m < m[kSlam].loop_closure_error_m);
+    CHECK(m[kGated].rmse_m < m[kOdom].rmse_m);
+    CHECK(m[kGated].max_yaw_error_deg < 6.0);
+    // Four 90° turns, found in the ground truth.
+    REQUIRE(r.turns.size() == 4);
+    CHECK(r.turns_from_groundtruth);
+    for (const auto& t : r.turns) CHECK(std::abs(t.angle_rad - std::numbers::pi / 2) < 0.05);
+    // One re-initialisation; the gated fuser anchored both maps.
+    CHECK(r.slam_reinit == 1);
+    CHECK(r.gated_anchors == 2);
+    CHECK(r.magnetometer_note.rfind("horizontal", 0) == 0);
+  }
+}
+
+TEST_CASE("Corridor: a written and re-read log gives identical numbers", "[fusion][corridor][io]") {
+  const auto sim = posefuse::simulate_corridor({}, 2);
+  const fs::path dir = scratch_dir();
+  posefuse::write_robot_log(dir, sim.log);
+  const auto back = posefuse::read_robot_log(dir);
+  fs::remove_all(dir);
+  const auto a = posefuse::run_corridor(sim.log);
+  const auto b = posefuse::run_corridor(back);
+  for (std::size_t k = 0; k < 4; ++k) {
+    INFO(posefuse::kCorridorMethodNames[k]);
+    CHECK(a.metrics[k].loop_closure_error_m == b.metrics[k].loop_closure_error_m);
+    CHECK(a.metrics[k].rmse_m == b.metrics[k].rmse_m);
+    CHECK(a.metrics[k].time_without_pose_s == b.metrics[k].time_without_pose_s);
+    CHECK(same(a.metrics[k].max_yaw_error_deg, b.metrics[k].max_yaw_error_deg));
+    REQUIRE(a.metrics[k].yaw_error_after_turn_deg.size() == b.metrics[k].yaw_error_after_turn_deg.size());
+    for (std::size_t i = 0; i < a.metrics[k].yaw_error_after_turn_deg.size(); ++i)
+      CHECK(same(a.metrics[k].yaw_error_after_turn_deg[i], b.metrics[k].yaw_error_after_turn_deg[i]));
+    CHECK(a.tracks[k].size() == b.tracks[k].size());
+  }
+}
+
+TEST_CASE("Corridor: other rates and phases, a SLAM map that is not the world frame",
+          "[fusion][corridor]") {
+  posefuse::CorridorSimConfig cfg;
+  cfg.wheel_rate_hz = 37;  // no common multiples: every stream on its own clock
+  cfg.imu_rate_hz = 113;
+  cfg.slam_rate_hz = 9;
+  cfg.truth_rate_hz = 71;
+  cfg.jitter_s = 0.004;
+  auto sim = posefuse::simulate_corridor(cfg, 4);
+  // Session 0 of SLAM in an arbitrary frame too: T_map0_world = (3, -2, 2.5 rad).
+  const posefuse::PlanarPose<double> T_m0w{3, -2, 2.5};
+  for (auto& s : sim.log.slam) {
+    if (s.state == posefuse::SlamState::kReinit) break;
+    if (s.state == posefuse::SlamState::kLost) continue;
+    const double yaw = 2 * std::atan2(s.q[2], s.q[3]);
+    const auto p = posefuse::se2_compose(T_m0w, posefuse::PlanarPose<double>{s.p[0], s.p[1], yaw});
+    s.p[0] = p.x;
+    s.p[1] = p.y;
+    s.q = {0, 0, std::sin(p.theta / 2), std::cos(p.theta / 2)};
+  }
+  const auto r = posefuse::run_corridor(sim.log);
+  const auto& m = r.metrics;
+  CHECK(m[kGated].loop_closure_error_m < 1.0);
+  CHECK(m[kGated].loop_closure_error_m < m[kOdom].loop_closure_error_m);
+  CHECK(m[kGated].time_without_pose_s == 0.0);
+  CHECK(r.gated_anchors == 2);
+  // SLAM alone is placed by its first pose, so its first map is fine (until corner 3).
+  CHECK(std::abs(m[kSlam].yaw_error_after_turn_deg.at(0)) < 3.0);
+  CHECK(m[kSlam].time_without_pose_s > 10.0);
+}
+
+TEST_CASE("Corridor: without ground truth the turns come from odometry, RMSE is NaN",
+          "[fusion][corridor]") {
+  auto sim = posefuse::simulate_corridor({}, 5);
+  sim.log.groundtruth.clear();
+  const auto r = posefuse::run_corridor(sim.log);
+  CHECK_FALSE(r.turns_from_groundtruth);
+  REQUIRE(r.turns.size() == 4);
+  for (std::size_t k = 0; k < 4; ++k) {
+    CHECK(std::isnan(r.metrics[k].rmse_m));
+    CHECK(r.metrics[k].yaw_error_after_turn_deg.size() == 4);
+  }
+  // Against square corners: the gated fuser's heading stays within a few degrees.
+  CHECK(r.metrics[kGated].max_yaw_error_deg < 6.0);
+  CHECK(r.metrics[kGated].loop_closure_error_m < 1.0);
+}
+
+TEST_CASE("Corridor: a log whose SLAM never tracks runs on odometry alone", "[fusion][corridor]") {
+  auto sim = posefuse::simulate_corridor({}, 6);
+  for (auto& s : sim.log.slam) s.state = posefuse::SlamState::kLost;
+  const auto r = posefuse::run_corridor(sim.log);
+  CHECK(r.tracks[kSlam].empty());
+  CHECK(std::isnan(r.metrics[kSlam].loop_closure_error_m));
+  CHECK(r.metrics[kSlam].time_without_pose_s == Approx(r.duration_s));
+  CHECK(r.gated_anchors == 0);
+  // The gated fuser then is dead reckoning, the seed fuser is O_m.
+  const auto& g = r.tracks[kGated].back().pose;
+  const auto& d = r.dead_reckoning.back().pose;
+  CHECK(g.x == Approx(d.x).margin(1e-9));
+  CHECK(g.y == Approx(d.y).margin(1e-9));
+  CHECK(r.metrics[kSeed].loop_closure_error_m == r.metrics[kOdom].loop_closure_error_m);
+}
