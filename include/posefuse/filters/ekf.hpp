@@ -261,15 +261,16 @@ class Ekf {
   template <class H>
   struct Gain {
     using SMat = CovarianceOf<typename H::Measurement>;
-    SMat S;
-    SMat S_inv;
-    Eigen::Matrix<Scalar, Dim, DimOf<typename H::Measurement>> K;
-    Covariance P_post;
+    SMat S = SMat::Zero();
+    SMat S_inv = SMat::Zero();
+    Eigen::Matrix<Scalar, Dim, DimOf<typename H::Measurement>> K =
+        Eigen::Matrix<Scalar, Dim, DimOf<typename H::Measurement>>::Zero();
+    Covariance P_post = Covariance::Zero();
   };
   template <class H>
   struct GainMemo {
     bool valid = false;
-    Covariance P_in;
+    Covariance P_in = Covariance::Zero();
     Gain<H> gain;
   };
 
