@@ -172,7 +172,7 @@ class CsvLine {
       : file_(file), line_(line), names_(names), fields_(split_csv(text)) {
     if (fields_.size() != names.size()) {
       std::string expected;
-      for (std::size_t i = 0; i < names.size(); ++i) expected += (i ? "," : "") + std::string(names[i]);
+      for (std::string_view n : names) (expected += expected.empty() ? "" : ",") += n;
       throw io_error(file, line, "expected " + std::to_string(names.size()) + " columns (" +
                                      expected + "), got " + std::to_string(fields_.size()));
     }
