@@ -137,6 +137,9 @@ void print_table(const posefuse::CorridorRunResult& r, const std::string& source
   const auto& m = r.metrics;
   std::printf("\nSLAM rows: %d valid, %d lost, %d re-initialisations. Magnetometer: %s.\n",
               r.slam_valid, r.slam_lost, r.slam_reinit, r.magnetometer_note.c_str());
+  if (r.slam_tilted * 10 > r.slam_valid)
+    std::printf("warning: %d SLAM poses are tilted by more than 20 deg; slam.csv should hold the body "
+                "pose in a z-up map frame (convert camera-frame poses first).\n", r.slam_tilted);
   std::printf("seed fuser: %d SLAM poses averaged (eq 15-a), %d fell back to O_m (eq 15-b).\n",
               r.seed_averaged, r.seed_fallback);
   std::printf("gated fuser: %d SLAM poses fused, %d rejected by the gates, %d map frames anchored.\n",

@@ -63,6 +63,7 @@ TEST_CASE("Corridor: SLAM alone fails at corner 3; the gated fuser completes the
     for (const auto& t : r.turns) CHECK(std::abs(t.angle_rad - std::numbers::pi / 2) < 0.05);
     // One re-initialisation; the gated fuser anchored both maps.
     CHECK(r.slam_reinit == 1);
+    CHECK(r.slam_tilted == 0);
     CHECK(r.gated_anchors == 2);
     CHECK(r.magnetometer_note.rfind("horizontal", 0) == 0);
   }
@@ -150,4 +151,16 @@ TEST_CASE("Corridor: a log whose SLAM never tracks runs on odometry alone", "[fu
   CHECK(g.x == Approx(d.x).margin(1e-9));
   CHECK(g.y == Approx(d.y).margin(1e-9));
   CHECK(r.metrics[kSeed].loop_closure_error_m == r.metrics[kOdom].loop_closure_error_m);
+}
+
+TEST_CASE("Corridor: camera-frame SLAM poses are flagged as tilted", "[fusion][corridor]") {
+  auto sim = posefuse::simulate_corridor({}, 2);
+  // Rotate every SLAM orientation by +90 deg about x (z forward would read as tilt).
+  const double h = std::sqrt(0.5);
+  for (auto& s : sim.log.slam) {
+    const auto [x, y, z, w] = s.q;
+    s.q = {h * (w + x), h * (y + z), h * (z - y), h * (w - x)};  // q * (h, 0, 0, h)... about x
+  }
+  const auto r = posefuse::run_corridor(sim.log);
+  CHECK(r.slam_tilted == r.slam_valid);
 }
