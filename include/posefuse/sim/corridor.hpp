@@ -63,34 +63,44 @@ struct CorridorSimConfig {
   double still_start_s = 3.0;       ///< standstill before moving (s)
   double still_end_s = 2.0;         ///< standstill after the last turn (s)
   double pause_s = 0.5;             ///< standstill before and after each turn (s)
-  double wheel_rate_hz = 50, imu_rate_hz = 100, slam_rate_hz = 15, truth_rate_hz = 100;
+  double wheel_rate_hz = 50;        ///< encoder sample rate (Hz)
+  double imu_rate_hz = 100;         ///< IMU sample rate (Hz)
+  double slam_rate_hz = 15;         ///< SLAM pose rate (Hz)
+  double truth_rate_hz = 100;       ///< ground-truth rate (Hz)
   double jitter_s = 0.002;          ///< uniform timestamp jitter, ± (s)
   std::int64_t t0_ns = 1'600'000'000'000'000'000;  ///< clock value of t = 0 (ns)
-  // Robot as written to robot.txt.
-  double ticks_per_rev = 1320, wheel_radius_m = 0.065, track_width_m = 0.40;
+  double ticks_per_rev = 1320;      ///< encoder ticks per wheel revolution (robot.txt)
+  double wheel_radius_m = 0.065;    ///< nominal wheel radius (m, robot.txt)
+  double track_width_m = 0.40;      ///< nominal effective track (m, robot.txt)
   double complementary_alpha = 0.98;  ///< written to robot.txt (seed eq 3-4)
   double fuser_threshold = 0.01;      ///< written to robot.txt (seed eq 15, m·rad)
-  // Encoder errors.
   double radius_error_sigma = 0.001;  ///< relative, fixed per wheel
   double track_error = 0.015;         ///< true effective track / nominal - 1
   double track_turn_sigma = 0.01;     ///< relative, per turn
   double slip_sigma = 0.01;           ///< relative, per encoder increment
-  // IMU errors.
-  double accel_noise = 0.05, accel_bias_sigma = 0.05;   ///< m/s²
-  double gyro_noise = 0.002, gyro_bias_sigma = 0.003;   ///< rad/s
-  double earth_h_uT = 30, earth_v_uT = 40;              ///< horizontal, downward field (µT)
-  double mag_noise_uT = 0.3, hard_iron_sigma_uT = 10, soft_iron_sigma = 0.05;
-  double disturbance_uT = 2, disturbance_width_m = 1.5;
-  int disturbance_blobs = 8;
-  // SLAM.
+  double accel_noise = 0.05;        ///< accelerometer white noise per sample (m/s²)
+  double accel_bias_sigma = 0.05;   ///< accelerometer constant bias, per axis (m/s²)
+  double gyro_noise = 0.002;        ///< gyro white noise per sample (rad/s)
+  double gyro_bias_sigma = 0.003;   ///< gyro constant bias, per axis (rad/s)
+  double earth_h_uT = 30;           ///< horizontal Earth field (µT)
+  double earth_v_uT = 40;           ///< downward Earth field (µT)
+  double mag_noise_uT = 0.3;        ///< magnetometer white noise (µT)
+  double hard_iron_sigma_uT = 10;   ///< hard-iron offset, per axis (µT)
+  double soft_iron_sigma = 0.05;    ///< soft-iron matrix I + symmetric N(0, σ)
+  double disturbance_uT = 2;        ///< indoor field disturbance per blob, per axis (µT)
+  double disturbance_width_m = 1.5; ///< blob width (m, 1-σ of a Gaussian)
+  int disturbance_blobs = 8;        ///< number of disturbance blobs
   double slam_init_s = 0.5;                         ///< tracking starts (s)
-  double slam_sigma_xy = 0.02, slam_sigma_yaw = 0.005;   ///< white (m, rad)
-  double slam_drift_xy = 0.03, slam_drift_yaw = 0.009;   ///< Gauss-Markov σ (m, rad)
-  double slam_drift_tau_s = 10;
+  double slam_sigma_xy = 0.02;      ///< white position noise (m)
+  double slam_sigma_yaw = 0.005;    ///< white yaw (and roll/pitch) noise (rad)
+  double slam_drift_xy = 0.03;      ///< Gauss-Markov position drift σ (m)
+  double slam_drift_yaw = 0.009;    ///< Gauss-Markov yaw drift σ (rad)
+  double slam_drift_tau_s = 10;     ///< Gauss-Markov time constant (s)
   double freeze_before_corner3_m = 1.5;  ///< the pose freezes this far before corner 3
   double frozen_s = 3.0;                 ///< frozen but reported `tracking` (s)
   double reinit_after_corner3_m = 3.0;   ///< re-initialisation this far into leg 3
-  double reinit_xy_m = 5.0, reinit_z_m = 0.5;  ///< new map frame offset ranges
+  double reinit_xy_m = 5.0;         ///< new map frame: x, y uniform in ± this (m)
+  double reinit_z_m = 0.5;          ///< new map frame: z uniform in [0, this] (m)
 };
 
 /// One leg or turn of the drive, for evaluation.
@@ -104,7 +114,9 @@ struct CorridorManoeuvre {
 struct CorridorSimulation {
   RobotLog log;                                  ///< the log (groundtruth.csv included)
   std::vector<CorridorManoeuvre> manoeuvres;     ///< legs and turns in order
-  double t_freeze_s = 0, t_lost_s = 0, t_reinit_s = 0;  ///< SLAM failure times (s)
+  double t_freeze_s = 0;                         ///< SLAM pose freezes (s since t0)
+  double t_lost_s = 0;                           ///< SLAM reports `lost` (s)
+  double t_reinit_s = 0;                         ///< SLAM re-initialises (s)
   std::array<double, 3> T_world_map1{};          ///< re-init map frame in world (x, y, yaw)
   double duration_s = 0;                         ///< total duration (s)
 };
