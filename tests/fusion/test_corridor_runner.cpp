@@ -6,6 +6,8 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <numbers>
 #include <unistd.h>
 #include <posefuse/fusion/corridor_runner.hpp>
 #include <posefuse/io/robot_log.hpp>
@@ -99,6 +101,12 @@ TEST_CASE("Corridor: other rates and phases, a SLAM map that is not the world fr
   cfg.truth_rate_hz = 71;
   cfg.jitter_s = 0.004;
   auto sim = posefuse::simulate_corridor(cfg, 4);
+  {  // through a log folder, as a recorded log would come
+    const fs::path dir = scratch_dir();
+    posefuse::write_robot_log(dir, sim.log);
+    sim.log = posefuse::read_robot_log(dir);
+    fs::remove_all(dir);
+  }
   // Session 0 of SLAM in an arbitrary frame too: T_map0_world = (3, -2, 2.5 rad).
   const posefuse::PlanarPose<double> T_m0w{3, -2, 2.5};
   for (auto& s : sim.log.slam) {
@@ -163,4 +171,56 @@ TEST_CASE("Corridor: camera-frame SLAM poses are flagged as tilted", "[fusion][c
   }
   const auto r = posefuse::run_corridor(sim.log);
   CHECK(r.slam_tilted == r.slam_valid);
+}
+
+TEST_CASE("Corridor: a hand-written log folder with interleaved stamps is processed by time",
+          "[fusion][corridor][io]") {
+  // Straight line at 0.2 m/s for 5 s. Wheels at 20 Hz (+3 ms), IMU at 100 Hz
+  // (+7 ms), SLAM at 15 Hz (+33 ms) with the exact pose: odometry must be
+  // interpolated to each SLAM stamp, or the seed fuser's average would be off
+  // by up to 0.2 m/s x 50 ms = 1 cm.
+  const fs::path dir = scratch_dir();
+  const double m_per_tick = 2 * std::numbers::pi * 0.05 / 1000;
+  const std::int64_t base = 1'700'000'000'000'000'000;
+  {
+    std::ofstream(dir / "robot.txt") << "ticks_per_rev 1000\nwheel_radius_m 0.05\n"
+                                        "track_width_m 0.3\ncomplementary_alpha 0.98\n"
+                                        "fuser_threshold 0.01\n";
+    std::ofstream w(dir / "wheels.csv"), i(dir / "imu.csv"), s(dir / "slam.csv");
+    w << "# t_ns,fl,fr,bl,br\n";
+    for (int k = 0; k <= 100; ++k) {
+      const double t = 0.003 + 0.05 * k;
+      const auto ticks = std::int64_t(std::floor(0.2 * t / m_per_tick));
+      w << base + std::int64_t(std::llround(t * 1e9)) << ',' << ticks << ',' << ticks << ','
+        << ticks << ',' << ticks << '\n';
+    }
+    i << "# t_ns,ax,ay,az,gx,gy,gz,mx,my,mz\n";
+    for (int k = 0; k < 500; ++k)
+      i << base + std::int64_t(std::llround((0.007 + 0.01 * k) * 1e9)) << ",0,0,9.81,0,0,0,30,0,-40\n";
+    s << "# t_ns,state,x,y,z,qx,qy,qz,qw\n" << base + 20'000'000 << ",lost,nan,nan,nan,nan,nan,nan,nan\n";
+    for (int k = 1; k < 75; ++k) {
+      const double t = 0.033 + k / 15.0;
+      s << base + std::int64_t(std::llround(t * 1e9)) << ",tracking," << 0.2 * t << ",0,0,0,0,0,1\n";
+    }
+  }
+  const auto log = posefuse::read_robot_log(dir);
+  fs::remove_all(dir);
+  const auto r = posefuse::run_corridor(log);
+  CHECK(r.slam_valid == 74);
+  CHECK(r.slam_lost == 1);
+  CHECK(r.magnetometer_note.rfind("not calibrated", 0) == 0);  // it never turned
+  CHECK(r.turns.empty());
+  int at_slam = 0;
+  for (const auto& p : r.tracks[kSeed]) {
+    // t = 0 is the first stamp of any stream: the wheels' 3 ms.
+    const double phase = std::fmod(p.t_s - 0.030, 1.0 / 15.0);
+    const bool slam_time = std::abs(phase) < 1e-6 || std::abs(phase - 1.0 / 15.0) < 1e-6;
+    if (!slam_time || p.t_s < 0.05) continue;
+    ++at_slam;
+    CHECK(std::abs(p.pose.x - 0.2 * (p.t_s + 0.003)) < 1e-3);
+  }
+  CHECK(at_slam > 60);
+  const auto& g = r.tracks[kGated].back();
+  CHECK(g.pose.x == Approx(0.2 * (g.t_s + 0.003)).margin(0.01));
+  CHECK(std::abs(g.pose.y) < 0.01);
 }
