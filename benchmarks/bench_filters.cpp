@@ -6,6 +6,11 @@
 // Side by side in this binary:
 //   BM_Seed000Ekf_Step/posefuse      posefuse::Ekf (fixed-size, Joseph form, LLT,
 //                                    identity Jacobians skipped at compile time)
+//   BM_Seed000Ekf_Step/posefuse_recompute
+//                                    the same filter through update_with(), which
+//                                    recomputes the gain every step (what any
+//                                    filter whose covariance has not converged,
+//                                    or whose noise varies, pays)
 //   BM_Seed000Ekf_Step/naive_fixed   the textbook step written directly with
 //                                    fixed-size Eigen (G, H multiplied, S inverted)
 //   BM_Seed000Ekf_Step/dynamic       the same textbook step with Eigen::MatrixXd
@@ -60,6 +65,23 @@ void BM_Seed000Ekf_Step_posefuse(benchmark::State& state) {
   benchmark::DoNotOptimize(ekf.state());
 }
 BENCHMARK(BM_Seed000Ekf_Step_posefuse)->Name("BM_Seed000Ekf_Step/posefuse");
+
+void BM_Seed000Ekf_Step_posefuse_recompute(benchmark::State& state) {
+  const Frames& f = frames();
+  const posefuse::PositionFix<2> fix = posefuse::PositionFix<2>::isotropic(0.5);
+  posefuse::Ekf<posefuse::PlanarDisplacement<double>, posefuse::PositionFix<2>> ekf(
+      posefuse::PlanarDisplacement<double>::from_sigmas(0.1, 0.1), fix);
+  ekf.reset(f.z[0], Eigen::Matrix2d::Identity());
+  std::size_t k = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(ekf.predict(f.u[k], 1.0));
+    auto r = ekf.update_with(fix, f.z[k]);
+    benchmark::DoNotOptimize(r);
+    k = (k + 1) & 1023;
+  }
+  benchmark::DoNotOptimize(ekf.state());
+}
+BENCHMARK(BM_Seed000Ekf_Step_posefuse_recompute)->Name("BM_Seed000Ekf_Step/posefuse_recompute");
 
 void BM_Seed000Ekf_Step_naive_fixed(benchmark::State& state) {
   const Frames& f = frames();
