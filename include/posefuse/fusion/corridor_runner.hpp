@@ -77,7 +77,7 @@ inline constexpr std::array<const char*, 4> kCorridorMethodNames{"slam_only", "o
 /// Options of run_corridor(); the defaults are the documented configuration.
 struct CorridorRunConfig {
   Integration integration = Integration::kEuler;  ///< eq 10 as printed
-  WheelNoiseParams wheel_noise{};                 ///< dead-reckoning covariance (reported only)
+  WheelNoiseParams wheel_noise{};                 ///< dead-reckoning covariance (not used by the methods)
   GatedFuserParams<double> gated{};               ///< the sound fuser
   double slam_stale_s = 0.3;       ///< seed fuser: SLAM older than this → O_r = O_m (s)
   double gap_s = 0.5;              ///< metrics: longer gaps count as "no valid pose" (s)

@@ -56,6 +56,7 @@
 
 #include <posefuse/core/angles.hpp>
 #include <posefuse/core/error.hpp>
+#include <posefuse/core/pipeline.hpp>
 #include <posefuse/models/planar_pose.hpp>
 
 namespace posefuse {
@@ -399,5 +400,8 @@ class GatedFuser {
   T travelled_ = 0;
   int n_cand_ = 0, rejects_ = 0, anchors_ = 0;
 };
+
+static_assert(Stage<GatedFuser<double>>);
+static_assert(Stage<GatedFuser<float>>);
 
 }  // namespace posefuse

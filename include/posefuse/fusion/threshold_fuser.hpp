@@ -20,6 +20,7 @@
 #include <concepts>
 
 #include <posefuse/core/error.hpp>
+#include <posefuse/core/pipeline.hpp>
 
 namespace posefuse {
 
@@ -111,5 +112,8 @@ class ThresholdFuser {
  private:
   T threshold_;
 };
+
+static_assert(Stage<ThresholdFuser<double>>);
+static_assert(Stage<ThresholdFuser<float>>);
 
 }  // namespace posefuse
