@@ -257,7 +257,7 @@ void write_corrected(const std::filesystem::path& file, const EstimateResult& r,
 void write_svg(const std::filesystem::path& file, const std::vector<EstimateResult>& results) {
   std::ofstream svg(file);
   if (!svg) throw io_error(file, "cannot open for writing");
-  const double W = 520, H = 420, pad = 30;
+  const double W = 520, H = 440, pad = 40;
   // Left panel: paths of the first estimate. Right panel: variance over time.
   const EstimateResult& r = results.front();
   Eigen::Vector2d lo = r.truth_xy.front(), hi = lo;
@@ -278,8 +278,8 @@ void write_svg(const std::filesystem::path& file, const std::vector<EstimateResu
   svg << "<svg xmlns='http://www.w3.org/2000/svg' width='" << 2 * W << "' height='" << H
       << "' font-family='sans-serif' font-size='12'>\n<rect width='100%' height='100%' "
          "fill='white'/>\n";
-  svg << "<text x='" << pad << "' y='18'>" << r.name
-      << ": road-plane paths (black truth, red raw, blue corrected cv+rts, green seed000)</text>\n";
+  svg << "<text x='" << pad << "' y='14'>" << r.name << ": road-plane paths</text>\n"
+      << "<text x='" << pad << "' y='28'>black truth, red raw, blue cv+rts, green seed000</text>\n";
   path(r.truth_xy, "black", 2.0);
   path(r.raw_xy, "red", 1.0);
   path(r.methods[2].points, "blue", 1.0);
@@ -296,8 +296,9 @@ void write_svg(const std::filesystem::path& file, const std::vector<EstimateResu
           << ',' << H - pad - (H - 2 * pad) * c[k] / vmax << ' ';
     svg << "'/>\n";
   };
-  svg << "<text x='" << W + pad << "' y='18'>position variance trace(P)/2 [m^2] per frame "
-      << "(green seed000, blue cv); max " << vmax << "</text>\n";
+  svg << "<text x='" << W + pad << "' y='14'>position variance trace(P)/2 per frame "
+      << "(seed 000 Fig. 8)</text>\n<text x='" << W + pad << "' y='28'>green seed000, blue cv; "
+      << "axis 0 to " << vmax << " m^2</text>\n";
   svg << "<line x1='" << W + pad << "' y1='" << H - pad << "' x2='" << 2 * W - pad << "' y2='"
       << H - pad << "' stroke='grey'/>\n";
   curve(v, "green");
