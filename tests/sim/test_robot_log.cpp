@@ -2,6 +2,7 @@
 // simulator, and file:line errors for malformed input.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <filesystem>
@@ -43,9 +44,12 @@ class Scratch {
 const char* kRobot =
     "# robot\nticks_per_rev 1320\nwheel_radius_m 0.065\ntrack_width_m 0.4\n"
     "complementary_alpha 0.98\nfuser_threshold 0.01\n";
-const char* kWheels = "# t_ns,fl,fr,bl,br\n100,0,0,0,0\n200,5,6,5,6\n300,10,12,10,12\n";
-const char* kImu = "# t_ns,ax,ay,az,gx,gy,gz,mx,my,mz\n150,0,0,9.81,0,0,0,30,0,-40\n";
-const char* kSlam = "# t_ns,state,x,y,z,qx,qy,qz,qw\n120,lost,0,0,0,0,0,0,1\n220,tracking,0.1,0,0,0,0,0,1\n";
+// Rows 0.1 s apart (t_ns in nanoseconds, as the format requires).
+const char* kWheels =
+    "# t_ns,fl,fr,bl,br\n100000000,0,0,0,0\n200000000,5,6,5,6\n300000000,10,12,10,12\n";
+const char* kImu = "# t_ns,ax,ay,az,gx,gy,gz,mx,my,mz\n150000000,0,0,9.81,0,0,0,30,0,-40\n";
+const char* kSlam = "# t_ns,state,x,y,z,qx,qy,qz,qw\n120000000,lost,0,0,0,0,0,0,1\n"
+                    "220000000,tracking,0.1,0,0,0,0,0,1\n";
 
 // A valid minimal log in `d`, then `name` replaced by `text`.
 void minimal_log(const Scratch& d, const std::string& name = "", const std::string& text = "") {
@@ -105,10 +109,10 @@ TEST_CASE("RobotLog: liberal about headers, spaces, CRLF, case and lost rows", "
   minimal_log(d, "slam.csv",
               "t_ns,state,x,y,z,qx,qy,qz,qw\r\n"  // uncommented column names
               "\r\n"
-              "120 , LOST , nan,nan,nan,nan,nan,nan,nan\r\n"  // lost poses may be NaN
-              "130,lost,,,,,,,\r\n"                            // ... or empty
-              "220,Tracking, 0.1 ,0,0,0,0,0,1\r\n"
-              "320,reinit,+5,0,0,0,0,0.7071068,0.7071068\r\n");
+              "120000000 , LOST , nan,nan,nan,nan,nan,nan,nan\r\n"  // lost poses may be NaN
+              "130000000,lost,,,,,,,\r\n"                            // ... or empty
+              "220000000,Tracking, 0.1 ,0,0,0,0,0,1\r\n"
+              "320000000,reinit,+5,0,0,0,0,0.7071068,0.7071068\r\n");
   d.write("robot.txt", std::string(kRobot) + "# trailing comment\n");
   const auto log = posefuse::read_robot_log(d.path());
   REQUIRE(log.slam.size() == 4);
@@ -174,4 +178,88 @@ TEST_CASE("RobotLog: missing files and keys are reported", "[sim][io][robot_log]
   minimal_log(d, "wheels.csv", "# only one row\n100,0,0,0,0\n");
   CHECK(error_of(d).find("wheels.csv: needs at least two data rows") != std::string::npos);
   CHECK_THROWS_AS(posefuse::read_robot_log(d.path() / "nope"), posefuse::io_error);
+}
+
+TEST_CASE("RobotLog: logs that parse but cannot be right are rejected, naming the file",
+          "[sim][io][robot_log]") {
+  struct Case {
+    const char* file;
+    const char* text;
+    const char* where;  // "<file>:<line>: " or "<file>: "
+    const char* what;   // part of the reason
+  };
+  const Case cases[] = {
+      // A 16-bit counter wrapping around on fl: 5 -> -32760 in 0.1 s.
+      {"wheels.csv", "# t_ns,fl,fr,bl,br\n100000000,0,0,0,0\n200000000,5,6,5,6\n300000000,-32760,12,10,12\n",
+       "wheels.csv:4: ", "fl jumps from 5 to -32760 ticks in 0.1000 s"},
+      {"wheels.csv", "100000000,0,0,0,0\n200000000,0,0,0,70000\n", "wheels.csv:2: ",
+       "wrap-around or reset"},
+      // Upside-down IMU (z down) and an IMU mounted on its side (gravity on x).
+      {"imu.csv", "150000000,0,0,-9.81,0,0,0,30,0,-40\n", "imu.csv: ",
+       "expected specific force +9.81 on z at rest, z up (REP-103)"},
+      {"imu.csv", "150000000,9.8,0,0.3,0,0,0,30,0,-40\n", "imu.csv: ", "gravity is mostly on x/y"},
+      // Another unit or epoch: slam.csv in microseconds, imu.csv in seconds.
+      {"slam.csv", "120000,lost,0,0,0,0,0,0,1\n220000,tracking,0.1,0,0,0,0,0,1\n", "slam.csv: ",
+       "nanoseconds on the same clock"},
+      {"imu.csv", "0,0,0,9.81,0,0,0,30,0,-40\n1,0,0,9.81,0,0,0,30,0,-40\n", "imu.csv: ",
+       "overlap by 0 %"},
+      // Squeezed into a thousandth of the wheels' span (ms written as µs, say).
+      {"groundtruth.csv", "100000000,0,0,0\n100100000,0,0,0\n100200000,0,0,0\n",
+       "groundtruth.csv: ", "t_ns spans"},
+      // Camera-frame poses: rotated 90 deg about x.
+      {"slam.csv", "120000000,tracking,0,0,0,0.7071068,0,0,0.7071068\n"
+                   "220000000,tracking,0,0,0.1,0.7071068,0,0,0.7071068\n",
+       "slam.csv: ", "2 of 2 poses tilted more than 20 deg from z-up; expected robot body poses "
+                     "in a z-up map frame (REP-103)"},
+  };
+  for (const auto& c : cases) {
+    Scratch d;
+    minimal_log(d, c.file, c.text);
+    const std::string msg = error_of(d);
+    INFO(c.file << ": " << msg);
+    CHECK(msg.find((d.path() / c.where).string()) == 0);
+    CHECK(msg.find(c.what) != std::string::npos);
+  }
+  // One tilted pose of three is not an error but a warning.
+  Scratch d;
+  minimal_log(d, "slam.csv", "120000000,tracking,0,0,0,0.7071068,0,0,0.7071068\n"
+                             "170000000,tracking,0,0,0,0,0,0,1\n220000000,tracking,0.1,0,0,0,0,0,1\n");
+  const auto log = posefuse::read_robot_log(d.path());
+  const auto w = posefuse::check_robot_log(log, d.path());
+  REQUIRE(w.size() == 1);
+  CHECK(w[0].find("slam.csv: 1 valid poses are tilted") != std::string::npos);
+}
+
+TEST_CASE("RobotLog: doubtful encoders and ground truth give warnings", "[sim][io][robot_log]") {
+  const auto sim = posefuse::simulate_corridor({}, 1);
+  CHECK(posefuse::check_robot_log(sim.log).empty());
+  const auto warned = [](const std::vector<std::string>& w, const char* part) {
+    return std::any_of(w.begin(), w.end(),
+                       [&](const std::string& s) { return s.find(part) != std::string::npos; });
+  };
+  {  // The left side counts backwards: the path spins instead of driving.
+    auto log = sim.log;
+    for (auto& r : log.wheels) r.fl = -r.fl, r.bl = -r.bl;
+    const auto w = posefuse::check_robot_log(log);
+    CHECK(warned(w, "wheels.csv: the encoder path turns"));
+    CHECK(warned(w, "does one side count backwards"));
+  }
+  {  // One wheel counts backwards.
+    auto log = sim.log;
+    for (auto& r : log.wheels) r.br = -r.br;
+    CHECK(warned(posefuse::check_robot_log(log), "wheels.csv: the right wheels disagree"));
+  }
+  {  // Every wheel counts backwards.
+    auto log = sim.log;
+    for (auto& r : log.wheels) r.fl = -r.fl, r.fr = -r.fr, r.bl = -r.bl, r.br = -r.br;
+    CHECK(warned(posefuse::check_robot_log(log), "wheels.csv: the encoder path runs mostly backwards"));
+  }
+  {  // Ground truth in another frame.
+    auto log = sim.log;
+    for (auto& g : log.groundtruth) g.x += 2.0;
+    CHECK(warned(posefuse::check_robot_log(log, "d"), "groundtruth.csv: the first pose is (2.00 m"));
+    log = sim.log;
+    for (auto& g : log.groundtruth) g.yaw += 0.2;
+    CHECK(warned(posefuse::check_robot_log(log), "ground truth in the odometry frame"));
+  }
 }

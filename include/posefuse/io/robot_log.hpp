@@ -31,7 +31,9 @@
 /// Every malformed input throws posefuse::io_error whose what() is
 /// `"<file>:<line>: <reason>"` (wrong column count, bad number, NaN/Inf,
 /// unknown state, non-increasing t_ns, unknown/duplicate/missing key,
-/// non-positive parameter, missing required file).
+/// non-positive parameter, missing required file), and so does a log that
+/// parses but cannot be right (robot_log_checks.hpp: clocks in another unit,
+/// IMU axes not z-up, camera-frame SLAM poses, encoder wrap-around).
 
 #include <array>
 #include <charconv>
@@ -39,234 +41,17 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
-#include <limits>
-#include <span>
 #include <string>
 #include <string_view>
 #include <system_error>
 #include <vector>
 
 #include <posefuse/core/error.hpp>
+#include <posefuse/io/detail/robot_log_csv.hpp>
+#include <posefuse/io/robot_log_checks.hpp>
+#include <posefuse/io/robot_log_records.hpp>
 
 namespace posefuse {
-
-/// One row of `wheels.csv`: cumulative ticks of the four wheels at `t_ns`.
-struct WheelRecord {
-  std::int64_t t_ns{0};  ///< timestamp (ns)
-  std::int64_t fl{0};    ///< front-left cumulative ticks
-  std::int64_t fr{0};    ///< front-right cumulative ticks
-  std::int64_t bl{0};    ///< back-left cumulative ticks
-  std::int64_t br{0};    ///< back-right cumulative ticks
-  friend bool operator==(const WheelRecord&, const WheelRecord&) = default;
-};
-
-/// One row of `imu.csv`, body frame x forward, y left, z up (REP-103).
-struct ImuRecord {
-  std::int64_t t_ns{0};                 ///< timestamp (ns)
-  std::array<double, 3> accel_mps2{};   ///< specific force (m/s²), +9.81 on z at rest
-  std::array<double, 3> gyro_radps{};   ///< angular rate (rad/s)
-  std::array<double, 3> mag_uT{};       ///< magnetic field (µT), as measured (uncalibrated)
-  friend bool operator==(const ImuRecord&, const ImuRecord&) = default;
-};
-
-/// Tracking state of a SLAM row.
-enum class SlamState {
-  kTracking,  ///< pose valid in the current map frame
-  kLost,      ///< no pose (the row's pose fields are ignored)
-  kReinit     ///< first pose of a new map frame
-};
-
-/// One row of `slam.csv`: body pose in the current SLAM map frame.
-struct SlamRecord {
-  std::int64_t t_ns{0};                   ///< timestamp (ns)
-  SlamState state{SlamState::kLost};      ///< tracking / lost / reinit
-  std::array<double, 3> p{};              ///< position (m) in the map frame
-  std::array<double, 4> q{0, 0, 0, 1};    ///< orientation quaternion (x, y, z, w)
-  friend bool operator==(const SlamRecord&, const SlamRecord&) = default;
-};
-
-/// One row of the optional `groundtruth.csv` (world = odometry frame).
-struct GroundTruthRecord {
-  std::int64_t t_ns{0};  ///< timestamp (ns)
-  double x{0};           ///< position x (m)
-  double y{0};           ///< position y (m)
-  double yaw{0};         ///< heading (rad)
-  friend bool operator==(const GroundTruthRecord&, const GroundTruthRecord&) = default;
-};
-
-/// The `robot.txt` parameters; all are required and must be positive.
-struct RobotLogParams {
-  double ticks_per_rev{0};        ///< encoder ticks per wheel revolution
-  double wheel_radius_m{0};       ///< wheel radius (m) — seed eq 9 (not the diameter)
-  double track_width_m{0};        ///< distance between left and right wheels (m), seed eq 9 `d`
-  double complementary_alpha{0};  ///< complementary-filter constant, 0 < alpha < 1 (seed eq 3-4)
-  double fuser_threshold{0};      ///< seed eq 15 threshold on O_diff (m·rad)
-  friend bool operator==(const RobotLogParams&, const RobotLogParams&) = default;
-};
-
-/// A whole recorded log (all streams kept in file order).
-struct RobotLog {
-  RobotLogParams params;                     ///< robot.txt
-  std::vector<WheelRecord> wheels;           ///< wheels.csv
-  std::vector<ImuRecord> imu;                ///< imu.csv
-  std::vector<SlamRecord> slam;              ///< slam.csv
-  std::vector<GroundTruthRecord> groundtruth;  ///< groundtruth.csv (empty when absent)
-  friend bool operator==(const RobotLog&, const RobotLog&) = default;
-};
-
-/// The text `slam.csv` uses for a state.
-[[nodiscard]] constexpr std::string_view to_string(SlamState s) noexcept {
-  return s == SlamState::kTracking ? "tracking" : s == SlamState::kLost ? "lost" : "reinit";
-}
-
-namespace detail {
-
-inline std::string_view trim(std::string_view s) noexcept {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
-  return s;
-}
-
-inline std::string lower(std::string_view s) {
-  std::string r(s);
-  for (char& c : r) c = (c >= 'A' && c <= 'Z') ? char(c - 'A' + 'a') : c;
-  return r;
-}
-
-/// Reads a text file as (line number, trimmed content) pairs, skipping blank
-/// and `#` lines.
-inline std::vector<std::pair<std::size_t, std::string>> read_content_lines(
-    const std::filesystem::path& file) {
-  if (!std::filesystem::is_regular_file(file)) throw io_error(file, "required file is missing");
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw io_error(file, "cannot open file");
-  std::vector<std::pair<std::size_t, std::string>> lines;
-  std::string line;
-  std::size_t n = 0;
-  while (std::getline(in, line)) {
-    ++n;
-    const std::string_view t = trim(line);
-    if (t.empty() || t.front() == '#') continue;
-    lines.emplace_back(n, std::string(t));
-  }
-  if (in.bad()) throw io_error(file, n, "read error");
-  return lines;
-}
-
-inline std::vector<std::string_view> split_csv(std::string_view s) {
-  std::vector<std::string_view> out;
-  for (;;) {
-    const std::size_t c = s.find(',');
-    out.push_back(trim(s.substr(0, c)));
-    if (c == std::string_view::npos) break;
-    s.remove_prefix(c + 1);
-  }
-  return out;
-}
-
-/// A cursor over one CSV data line that parses its fields in order.
-class CsvLine {
- public:
-  CsvLine(const std::filesystem::path& file, std::size_t line, std::string_view text,
-          std::span<const std::string_view> names)
-      : file_(file), line_(line), names_(names), fields_(split_csv(text)) {
-    if (fields_.size() != names.size()) {
-      std::string expected;
-      for (std::string_view n : names) (expected += expected.empty() ? "" : ",") += n;
-      throw io_error(file, line, "expected " + std::to_string(names.size()) + " columns (" +
-                                     expected + "), got " + std::to_string(fields_.size()));
-    }
-  }
-  std::int64_t integer() {
-    const std::string_view f = next();
-    std::string_view g = f;
-    if (!g.empty() && g.front() == '+') g.remove_prefix(1);
-    std::int64_t v = 0;
-    const auto [ptr, ec] = std::from_chars(g.data(), g.data() + g.size(), v);
-    if (g.empty() || ec != std::errc{} || ptr != g.data() + g.size()) fail("an integer", f);
-    return v;
-  }
-  double real(bool allow_non_finite = false) {
-    const std::string_view f = next();
-    if (allow_non_finite && f.empty()) return std::numeric_limits<double>::quiet_NaN();
-    std::string_view g = f;
-    if (!g.empty() && g.front() == '+') g.remove_prefix(1);
-    double v = 0;
-    const auto [ptr, ec] = std::from_chars(g.data(), g.data() + g.size(), v);
-    if (g.empty() || ec != std::errc{} || ptr != g.data() + g.size()) fail("a number", f);
-    if (!allow_non_finite && !std::isfinite(v))
-      throw io_error(file_, line_, "column '" + std::string(names_[i_ - 1]) +
-                                       "' is not finite ('" + std::string(f) + "')");
-    return v;
-  }
-  std::string_view text() { return next(); }
-  [[noreturn]] void error(const std::string& reason) const { throw io_error(file_, line_, reason); }
-  [[noreturn]] void fail(const char* what, std::string_view f) const {
-    throw io_error(file_, line_, "column '" + std::string(names_[i_ - 1]) + "' is not " + what +
-                                     " ('" + std::string(f) + "')");
-  }
-
- private:
-  std::string_view next() { return fields_[i_++]; }
-  const std::filesystem::path& file_;
-  std::size_t line_;
-  std::span<const std::string_view> names_;
-  std::vector<std::string_view> fields_;
-  std::size_t i_ = 0;
-};
-
-/// True when a line is the file's column names (an uncommented header).
-inline bool is_column_header(std::string_view text, std::span<const std::string_view> names) {
-  const auto f = split_csv(text);
-  if (f.size() != names.size()) return false;
-  for (std::size_t i = 0; i < f.size(); ++i) {
-    if (lower(f[i]) != names[i]) return false;
-  }
-  return true;
-}
-
-/// Parses every data line of a CSV file with `row(CsvLine&) -> Record`, and
-/// checks that t_ns increases strictly.
-template <class Record, class RowFn>
-std::vector<Record> read_csv(const std::filesystem::path& file,
-                             std::span<const std::string_view> names, RowFn row) {
-  std::vector<Record> out;
-  std::size_t prev_line = 0;
-  for (const auto& [n, text] : read_content_lines(file)) {
-    if (out.empty() && is_column_header(text, names)) continue;
-    CsvLine c(file, n, text, names);
-    Record r = row(c);
-    if (!out.empty() && r.t_ns <= out.back().t_ns)
-      throw io_error(file, n, "t_ns " + std::to_string(r.t_ns) +
-                                  " does not increase (previous row, line " +
-                                  std::to_string(prev_line) + ", has " +
-                                  std::to_string(out.back().t_ns) + ")");
-    out.push_back(r);
-    prev_line = n;
-  }
-  return out;
-}
-
-inline std::string fmt(double v) {
-  std::array<char, 64> buf{};
-  const auto r = std::to_chars(buf.data(), buf.data() + buf.size(), v);  // shortest round-trip
-  return std::string(buf.data(), r.ptr);
-}
-
-inline std::ofstream open_for_writing(const std::filesystem::path& file) {
-  std::ofstream out(file, std::ios::binary | std::ios::trunc);
-  if (!out) throw io_error(file, "cannot open file for writing");
-  return out;
-}
-
-inline constexpr std::array<std::string_view, 5> kWheelCols{"t_ns", "fl", "fr", "bl", "br"};
-inline constexpr std::array<std::string_view, 10> kImuCols{"t_ns", "ax", "ay", "az", "gx",
-                                                           "gy",   "gz", "mx", "my", "mz"};
-inline constexpr std::array<std::string_view, 9> kSlamCols{"t_ns", "state", "x",  "y", "z",
-                                                           "qx",   "qy",    "qz", "qw"};
-inline constexpr std::array<std::string_view, 4> kTruthCols{"t_ns", "x", "y", "yaw"};
-
-}  // namespace detail
 
 /// Reads `robot.txt` (`key value` lines, `#` comments, also after a value).
 /// @param[in] file path of robot.txt
@@ -330,13 +115,15 @@ inline constexpr std::array<std::string_view, 4> kTruthCols{"t_ns", "x", "y", "y
 ///            and optionally groundtruth.csv
 /// @return the log, rows in file order
 /// @throws posefuse::io_error naming file and line for anything malformed;
-///         also when wheels.csv has fewer than two rows or imu.csv none
+///         also when wheels.csv has fewer than two rows or imu.csv none, and
+///         for the errors of check_robot_log()
 [[nodiscard]] inline RobotLog read_robot_log(const std::filesystem::path& dir) {
   using detail::CsvLine;
   if (!std::filesystem::is_directory(dir)) throw io_error(dir, "log folder does not exist");
   RobotLog log;
   log.params = read_robot_params(dir / "robot.txt");
   const auto wheels_file = dir / "wheels.csv";
+  std::vector<std::size_t> wheel_lines;
   log.wheels = detail::read_csv<WheelRecord>(wheels_file, detail::kWheelCols, [](CsvLine& c) {
     WheelRecord r;
     r.t_ns = c.integer();
@@ -345,8 +132,9 @@ inline constexpr std::array<std::string_view, 4> kTruthCols{"t_ns", "x", "y", "y
     r.bl = c.integer();
     r.br = c.integer();
     return r;
-  });
+  }, &wheel_lines);
   if (log.wheels.size() < 2) throw io_error(wheels_file, "needs at least two data rows");
+  check_wheel_increments(log.wheels, log.params, wheels_file, wheel_lines);
   const auto imu_file = dir / "imu.csv";
   log.imu = detail::read_csv<ImuRecord>(imu_file, detail::kImuCols, [](CsvLine& c) {
     ImuRecord r;
@@ -390,6 +178,7 @@ inline constexpr std::array<std::string_view, 4> kTruthCols{"t_ns", "x", "y", "y
           return r;
         });
   }
+  (void)check_robot_log(log, dir);  // clocks, IMU axes, SLAM tilt; warnings: run_corridor
   return log;
 }
 
