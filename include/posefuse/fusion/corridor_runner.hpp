@@ -19,10 +19,15 @@
 /// plane (an ellipse through all readings: a ground robot turns about z only,
 /// which leaves a 3-D ellipsoid fit undetermined; this uses the whole log,
 /// i.e. it is an offline calibration, as the seed's sensor did it
-/// internally). The compass yaw is aligned to the world frame by its
-/// circular mean over the first `heading_align_s` of IMU data (world heading
-/// is 0 at the start). Seed odometry O_m = (x, y from the wheels; roll,
-/// pitch, yaw from the IMU).
+/// internally). The compass yaw is aligned to the world (= odometry) frame
+/// by the circular mean of angle_diff(compass yaw, encoder heading) over the
+/// first `heading_align_s` in which both streams have data, so an IMU that
+/// starts late, or a robot that turns at the start, is aligned correctly.
+/// Seed odometry O_m = (x, y from the wheels; roll, pitch, yaw from the IMU).
+/// An attitude older than `attitude_max_age_s` (default: 5 median IMU
+/// periods) is not used: O_m's yaw is then the encoder heading plus the last
+/// compass-minus-encoder offset, and roll = pitch = 0 (an IMU that stops,
+/// starts late or has gaps); the time this happens is warned about.
 ///
 /// **Methods** (each reports poses in the world = odometry frame):
 /// * `slam_only` — SLAM poses as reported (tracking and reinit rows), placed
@@ -45,9 +50,12 @@
 ///   over-trusts; on the simulated corridor (seeds 1-8) they made the loop
 ///   closure better on some seeds and worse on others, the same on average.
 ///
-/// SLAM poses are taken as the body pose in a z-up map frame; a pose tilted
-/// by more than 20° is counted in `slam_tilted` (a camera-frame pose, z
-/// forward, would be: convert such logs first).
+/// **Checks.** The log first goes through check_robot_log()
+/// (io/robot_log_checks.hpp): clocks, IMU axes, SLAM poses that are not z-up
+/// body poses (more than half tilted by more than 20° is an error, naming
+/// slam.csv), encoder wrap-around, and warnings. Those warnings, and the
+/// runner's own (SLAM never anchored by the gated fuser, stale attitude), are
+/// in `warnings`: a number computed from a doubtful log says so.
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -64,6 +72,7 @@
 #include <posefuse/fusion/gated_fuser.hpp>
 #include <posefuse/fusion/threshold_fuser.hpp>
 #include <posefuse/io/robot_log.hpp>
+#include <posefuse/io/robot_log_checks.hpp>
 #include <posefuse/sensors/pipelines.hpp>
 
 namespace posefuse {
@@ -82,6 +91,7 @@ struct CorridorRunConfig {
   double slam_stale_s = 0.3;       ///< seed fuser: SLAM older than this → O_r = O_m (s)
   double gap_s = 0.5;              ///< metrics: longer gaps count as "no valid pose" (s)
   double heading_align_s = 1.0;    ///< compass → world heading alignment window (s)
+  double attitude_max_age_s = 0;   ///< older attitude is not used (s); 0: 5 median IMU periods
   bool calibrate_magnetometer = true;  ///< horizontal hard/soft-iron fit over the log
   bool compass_in_gated = false;       ///< gated fuser uses compass heading updates (see file comment)
   double compass_period_s = 1.0;       ///< at most one compass update per period (s)
@@ -98,10 +108,14 @@ struct CorridorRunResult {
   bool turns_from_groundtruth = false;      ///< else from dead reckoning
   double duration_s = 0;                    ///< first to last sample (s)
   MagnetometerCalibration magnetometer;     ///< calibration used
+  bool magnetometer_calibrated = false;     ///< the hard/soft-iron fit succeeded
   std::string magnetometer_note;            ///< how it was obtained
-  double heading_offset_rad = 0;            ///< compass yaw at the start (subtracted)
+  double heading_offset_rad = 0;            ///< compass minus encoder heading at the start (subtracted)
+  double attitude_max_age_s = 0;            ///< attitude older than this was not used (s)
+  double attitude_stale_s = 0;              ///< wheel time without a usable attitude (s)
+  std::vector<std::string> warnings;        ///< doubts about the log or the result, one line each
   int slam_valid = 0, slam_lost = 0, slam_reinit = 0;          ///< SLAM rows by state
-  int slam_tilted = 0;                      ///< valid SLAM poses with |roll| or |pitch| > 20°
+  int slam_tilted = 0;                      ///< valid SLAM poses tilted > 20° from z-up
   int seed_averaged = 0, seed_fallback = 0, seed_restarts = 0;  ///< eq 15-a / 15-b / restarts
   int gated_fused = 0, gated_rejected = 0, gated_anchors = 0;   ///< SLAM poses in the gated fuser
   int compass_fused = 0, compass_rejected = 0;                  ///< compass updates
@@ -188,11 +202,14 @@ inline PlanarPose<double> planar(const SeedOdometry<double>& o) { return {o.x, o
 /// @return tracks, metrics and counters
 /// @throws posefuse::invalid_argument if robot.txt's parameters are unusable,
 ///         or (for a log not made by read_robot_log) stamps do not increase
+/// @throws posefuse::io_error for the errors of check_robot_log(), naming the
+///         file (slam.csv for camera-frame poses, ...)
 [[nodiscard]] inline CorridorRunResult run_corridor(const RobotLog& log,
                                                     const CorridorRunConfig& cfg = {}) {
   CorridorRunResult res;
   if (log.wheels.empty() || log.imu.empty())
     throw invalid_argument("run_corridor: the log needs wheel and IMU samples");
+  res.warnings = check_robot_log(log);
   std::int64_t t0 = std::min(log.wheels.front().t_ns, log.imu.front().t_ns);
   std::int64_t t1 = std::max(log.wheels.back().t_ns, log.imu.back().t_ns);
   if (!log.slam.empty()) {
@@ -204,25 +221,43 @@ inline PlanarPose<double> planar(const SeedOdometry<double>& o) { return {o.x, o
   for (const auto& g : log.groundtruth) res.groundtruth.push_back({sec(g.t_ns), {g.x, g.y, g.yaw}});
 
   // --- Magnetometer calibration and heading alignment (pre-passes).
-  if (cfg.calibrate_magnetometer) detail::fit_horizontal_ellipse(log.imu, res.magnetometer, res.magnetometer_note);
+  if (cfg.calibrate_magnetometer)
+    res.magnetometer_calibrated =
+        detail::fit_horizontal_ellipse(log.imu, res.magnetometer, res.magnetometer_note);
   else res.magnetometer_note = "not calibrated (disabled)";
   const AttitudeConfig att_cfg{log.params.complementary_alpha, GyroToTiltRate::kSeed, res.magnetometer, 0.0};
+  const DiffDriveParams dd{log.params.ticks_per_rev, log.params.wheel_radius_m, log.params.track_width_m};
   {
+    PlanarTrack enc;  // encoder heading, to align the compass to
+    auto odo = make_odometry_pipeline(dd, cfg.wheel_noise, cfg.integration);
+    for (const auto& w : log.wheels)
+      enc.push_back({sec(w.t_ns), odo(StampedWheelTicks{sec(w.t_ns), {w.fl, w.fr, w.bl, w.br}}).pose});
+    const double ta = std::max(sec(log.wheels.front().t_ns), sec(log.imu.front().t_ns));
     auto align = make_attitude_pipeline(att_cfg);
     double ss = 0, sc = 0;
+    int n = 0;
     for (const auto& r : log.imu) {
-      if (sec(r.t_ns) > sec(log.imu.front().t_ns) + cfg.heading_align_s) break;
-      const Attitude a = align(detail::to_sample(r, sec(r.t_ns)));
-      if (a.status != SampleStatus::kOk && a.status != SampleStatus::kFirst) continue;
-      ss += std::sin(a.yaw);
-      sc += std::cos(a.yaw);
+      const double t = sec(r.t_ns);
+      if (t > ta + cfg.heading_align_s) break;
+      const Attitude a = align(detail::to_sample(r, t));
+      const auto e = interpolate_track(enc, t);
+      if (t < ta || !e || (a.status != SampleStatus::kOk && a.status != SampleStatus::kFirst)) continue;
+      const double d = angle_diff(a.yaw, e->theta);
+      ss += std::sin(d);
+      sc += std::cos(d);
+      ++n;
     }
-    res.heading_offset_rad = (ss == 0 && sc == 0) ? 0.0 : std::atan2(ss, sc);
+    res.heading_offset_rad = n == 0 ? 0.0 : std::atan2(ss, sc);
+    std::vector<double> dt;
+    for (std::size_t i = 1; i < log.imu.size(); ++i) dt.push_back(sec(log.imu[i].t_ns) - sec(log.imu[i - 1].t_ns));
+    std::nth_element(dt.begin(), dt.begin() + std::ptrdiff_t(dt.size() / 2), dt.end());
+    res.attitude_max_age_s = cfg.attitude_max_age_s > 0 ? cfg.attitude_max_age_s
+                             : dt.empty()               ? 0.5
+                                                        : 5 * dt[dt.size() / 2];
   }
 
   // --- Chains and methods.
   auto attitude = make_attitude_pipeline(att_cfg);
-  const DiffDriveParams dd{log.params.ticks_per_rev, log.params.wheel_radius_m, log.params.track_width_m};
   auto odometry = make_odometry_pipeline(dd, cfg.wheel_noise, cfg.integration);
   const ThresholdFuser<double> seed(log.params.fuser_threshold);
   GatedFuser<double> gated(cfg.gated);
@@ -230,7 +265,8 @@ inline PlanarPose<double> planar(const SeedOdometry<double>& o) { return {o.x, o
 
   bool have_att = false, have_wheel = false, so_aligned = false, seed_place = true, seed_started = false;
   Attitude att;
-  double t_prev = 0, last_slam_t = -1e300, last_compass_t = -1e300;
+  double t_prev = 0, last_slam_t = -1e300, last_compass_t = -1e300, att_t = -1e300;
+  double enc_offset = 0;  // world yaw minus encoder heading, from the last usable attitude
   PlanarPose<double> dr_prev, dr_now, T_so, T_seed;
   SeedOdometry<double> om_prev, om_now;
   std::vector<const SlamRecord*> pending;
@@ -244,7 +280,7 @@ inline PlanarPose<double> planar(const SeedOdometry<double>& o) { return {o.x, o
     const Eigen::Quaterniond q(r.q[3], r.q[0], r.q[1], r.q[2]);
     const EulerZYX<double> e = euler_zyx_from_rotation(q.normalized().toRotationMatrix());  // eq 11-13
     const PlanarPose<double> z{r.p[0], r.p[1], wrap_angle(e.yaw)};
-    res.slam_tilted += std::abs(e.roll) > 0.35 || std::abs(e.pitch) > 0.35;
+    res.slam_tilted += slam_pose_tilted(r);
     // SLAM alone: placed once, at its first valid pose.
     if (!so_aligned) T_so = se2_compose(dr, se2_inverse(z));
     so_aligned = true;
@@ -283,14 +319,18 @@ inline PlanarPose<double> planar(const SeedOdometry<double>& o) { return {o.x, o
       if (a.status == SampleStatus::kNonFinite) continue;
       att = a;
       att.yaw = wrap_angle(a.yaw - res.heading_offset_rad);
+      att_t = sec(ti);
       have_att = true;
     } else if (tw <= ts) {  // wheels
       const auto& w = log.wheels[iw++];
       const double t = sec(w.t_ns);
       const PoseWithCovariance pw = odometry(StampedWheelTicks{t, {w.fl, w.fr, w.bl, w.br}});
       dr_now = pw.pose;
-      om_now = {dr_now.x, dr_now.y, have_att ? att.roll : 0.0, have_att ? att.pitch : 0.0,
-                have_att ? att.yaw : dr_now.theta};
+      const bool fresh = have_att && t - att_t <= res.attitude_max_age_s;
+      if (fresh) enc_offset = angle_diff(att.yaw, dr_now.theta);
+      else if (have_wheel) res.attitude_stale_s += t - t_prev;
+      om_now = {dr_now.x, dr_now.y, fresh ? att.roll : 0.0, fresh ? att.pitch : 0.0,
+                fresh ? att.yaw : wrap_angle(dr_now.theta + enc_offset)};
       if (!have_wheel) {
         dr_prev = dr_now;
         om_prev = om_now;
@@ -307,7 +347,7 @@ inline PlanarPose<double> planar(const SeedOdometry<double>& o) { return {o.x, o
       }
       pending.clear();
       (void)gated.predict(dr_now);
-      if (cfg.compass_in_gated && have_att && t - last_compass_t >= cfg.compass_period_s) {
+      if (cfg.compass_in_gated && fresh && t - last_compass_t >= cfg.compass_period_s) {
         const FuserStatus st = gated.update_heading(att.yaw, cfg.compass_sigma_rad);
         res.compass_fused += st == FuserStatus::kFused;
         res.compass_rejected += is_rejection(st);
@@ -329,6 +369,23 @@ inline PlanarPose<double> planar(const SeedOdometry<double>& o) { return {o.x, o
     gated_track.push_back({sec(pending.back()->t_ns), gated.pose()});
   }
   res.gated_anchors = gated.anchor_count();
+  if (res.slam_valid > 0 && res.gated_anchors == 0)
+    res.warnings.push_back(
+        "gated_fuser: SLAM map never anchored: none of the " + std::to_string(res.slam_valid) +
+        " valid SLAM poses agreed with odometry (non-metric, e.g. monocular, SLAM scale? wrong "
+        "robot.txt geometry? a frozen pose?); gated_fuser is odometry only");
+  else if (res.slam_valid >= 20 && 2 * res.gated_fused < res.slam_valid)
+    res.warnings.push_back(
+        "gated_fuser: fused only " + std::to_string(res.gated_fused) + " of " +
+        std::to_string(res.slam_valid) + " valid SLAM poses (" + std::to_string(res.gated_rejected) +
+        " rejected by the gates, the rest spent anchoring): SLAM and odometry disagree "
+        "(non-metric SLAM scale? wrong robot.txt geometry?)");
+  if (res.attitude_stale_s > 1.0)
+    res.warnings.push_back(
+        "imu.csv: no attitude younger than " + detail::num_text(res.attitude_max_age_s, 3) +
+        " s for " + detail::num_text(res.attitude_stale_s, 1) +
+        " s of the wheel data (IMU starts late, stops early or has gaps); odometry_only and "
+        "seed_fuser used the encoder heading plus the last compass offset there");
 
   // --- Metrics.
   res.turns_from_groundtruth = !res.groundtruth.empty();

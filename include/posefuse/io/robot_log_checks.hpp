@@ -253,8 +253,8 @@ inline void check_stream_clocks(const RobotLog& log, const std::filesystem::path
                          ": the first pose is (" + detail::num_text(g.x, 2) + " m, " +
                          detail::num_text(g.y, 2) + " m, " +
                          detail::num_text(yaw * 180.0 / std::numbers::pi, 1) +
-                         " deg), not the origin with yaw 0; RMSE and yaw errors assume ground "
-                         "truth in the odometry frame (the robot's pose at its first sample)");
+                         " deg), not the origin with yaw 0; the metrics (RMSE, yaw errors) assume "
+                         "ground truth in the odometry frame (the robot's pose at its first sample)");
   }
   return warnings;
 }
