@@ -15,22 +15,25 @@
 //
 // Expected output (default: simulation, seed 1):
 //
-//   method          loop closure (m)  RMSE (m)  no pose (s)  max yaw err (deg)
-//   slam_only                  3.461     2.509         14.4               39.6
-//   odometry_only              2.025     1.063          0.0                6.5
-//   seed_fuser                 1.862     0.968          0.0              180.0
-//   gated_fuser                0.531     0.315          0.0                2.2
+//   method          loop closure (m)  RMSE (m)  no pose (s)  max yaw err (deg)  max yaw err (deg)
+//                                                                  after turns          all poses
+//   slam_only                  3.461     2.509         14.4               38.0               39.6
+//   odometry_only              2.025     1.063          0.0                3.5                6.5
+//   seed_fuser                 1.862     0.968          0.0                2.0              180.0
+//   gated_fuser                0.531     0.315          0.0                1.4                2.2
 //
 //   yaw error after each 90-degree turn (deg; seed 001 reports about 1.9):
 //   slam_only          +0.6     lost    +37.9    +38.0
-//   odometry_only      +0.3     +0.4     +3.5     +0.4
-//   seed_fuser         +0.9     +0.4     +2.0     -0.5
+//   odometry_only      +0.3     +0.5     +3.5     +0.4
+//   seed_fuser         +0.9     +0.5     +2.0     -0.5
 //   gated_fuser        +0.1     +1.1     +1.3     +1.4
 //
 // i.e. SLAM alone has no pose for 14 s after corner 3 and then reports poses
 // in the wrong frame; the gated fuser completes the loop; the seed's fuser
 // follows odometry once SLAM is lost and, averaging raw angles near ±180°,
-// once reports a heading 180° off. Exact figures: run it.
+// once reports a heading 180° off ("all poses"). Doubts about a log (see
+// posefuse/io/robot_log_checks.hpp) are printed as "warning:" lines and in
+// --json under "warnings".
 
 #include <cmath>
 #include <cstdio>
@@ -116,14 +119,16 @@ void print_table(const posefuse::CorridorRunResult& r, const std::string& source
   std::printf("corridor_fusion: %s, %.1f s, %zu turns (%s)\n\n", source.c_str(), r.duration_s,
               r.turns.size(), r.turns_from_groundtruth ? "from ground truth" : "from odometry; "
               "yaw errors against square corners");
-  std::printf("%-14s  %16s  %8s  %11s  %17s\n", "method", "loop closure (m)", "RMSE (m)",
-              "no pose (s)", "max yaw err (deg)");
+  std::printf("%-14s  %16s  %8s  %11s  %17s  %17s\n", "method", "loop closure (m)", "RMSE (m)",
+              "no pose (s)", "max yaw err (deg)", "max yaw err (deg)");
+  std::printf("%-14s  %16s  %8s  %11s  %17s  %17s\n", "", "", "", "", "after turns", "all poses");
   for (std::size_t k = 0; k < 4; ++k) {
     const auto& m = r.metrics[k];
-    std::printf("%-14s  %16s  %8s  %11.1f  %17s\n", kCorridorMethodNames[k],
+    std::printf("%-14s  %16s  %8s  %11.1f  %17s  %17s\n", kCorridorMethodNames[k],
                 m.poses ? num(m.loop_closure_error_m, 3).c_str() : "no pose",
                 std::isfinite(m.rmse_m) ? num(m.rmse_m, 3).c_str() : "n/a", m.time_without_pose_s,
-                std::isfinite(m.max_yaw_error_deg) ? num(m.max_yaw_error_deg, 1).c_str() : "n/a");
+                std::isfinite(m.max_yaw_error_deg) ? num(m.max_yaw_error_deg, 1).c_str() : "n/a",
+                std::isfinite(m.max_yaw_error_all_deg) ? num(m.max_yaw_error_all_deg, 1).c_str() : "n/a");
   }
   std::printf("\nyaw error after each 90-degree turn (deg; seed 001 reports about 1.9):\n");
   for (std::size_t k = 0; k < 4; ++k) {
@@ -135,11 +140,8 @@ void print_table(const posefuse::CorridorRunResult& r, const std::string& source
     std::printf("\n");
   }
   const auto& m = r.metrics;
-  std::printf("\nSLAM rows: %d valid, %d lost, %d re-initialisations. Magnetometer: %s.\n",
-              r.slam_valid, r.slam_lost, r.slam_reinit, r.magnetometer_note.c_str());
-  if (r.slam_tilted * 10 > r.slam_valid)
-    std::printf("warning: %d SLAM poses are tilted by more than 20 deg; slam.csv should hold the body "
-                "pose in a z-up map frame (convert camera-frame poses first).\n", r.slam_tilted);
+  std::printf("\nSLAM rows: %d valid (%d tilted), %d lost, %d re-initialisations. Magnetometer: %s.\n",
+              r.slam_valid, r.slam_tilted, r.slam_lost, r.slam_reinit, r.magnetometer_note.c_str());
   std::printf("seed fuser: %d SLAM poses averaged (eq 15-a), %d fell back to O_m (eq 15-b).\n",
               r.seed_averaged, r.seed_fallback);
   std::printf("gated fuser: %d SLAM poses fused, %d rejected by the gates, %d map frames anchored.\n",
@@ -152,6 +154,8 @@ void print_table(const posefuse::CorridorRunResult& r, const std::string& source
               num(gf, 2).c_str(), gf < od ? "better" : "NOT better", num(od, 2).c_str());
   std::printf("Seed fuser: ends %s m from the start — %s than odometry alone.\n", num(sf, 2).c_str(),
               sf < od ? "better" : "worse or no better");
+  if (!r.warnings.empty()) std::printf("\n");
+  for (const auto& w : r.warnings) std::printf("warning: %s\n", w.c_str());
 }
 
 std::string json_escape(const std::string& s) {
@@ -171,20 +175,26 @@ void print_json(const posefuse::CorridorRunResult& r, const std::string& source)
   for (std::size_t k = 0; k < 4; ++k) {
     const auto& m = r.metrics[k];
     std::printf("    \"%s\": {\"loop_closure_error\": %s, \"rmse\": %s, \"time_without_pose_s\": %s, "
-                "\"max_yaw_error_deg\": %s, \"yaw_error_after_turn_deg\": [",
+                "\"max_yaw_error_deg\": %s, \"max_yaw_error_all_deg\": %s, \"yaw_error_after_turn_deg\": [",
                 posefuse::kCorridorMethodNames[k], num(m.loop_closure_error_m, 4).c_str(),
                 num(m.rmse_m, 4).c_str(), num(m.time_without_pose_s, 3).c_str(),
-                num(m.max_yaw_error_deg, 3).c_str());
+                num(m.max_yaw_error_deg, 3).c_str(), num(m.max_yaw_error_all_deg, 3).c_str());
     for (std::size_t i = 0; i < m.yaw_error_after_turn_deg.size(); ++i)
       std::printf("%s%s", i ? ", " : "", num(m.yaw_error_after_turn_deg[i], 3).c_str());
     std::printf("], \"poses\": %zu}%s\n", m.poses, k < 3 ? "," : "");
   }
-  std::printf("  },\n  \"slam\": {\"valid\": %d, \"lost\": %d, \"reinit\": %d},\n", r.slam_valid,
-              r.slam_lost, r.slam_reinit);
+  std::printf("  },\n  \"slam\": {\"valid\": %d, \"lost\": %d, \"reinit\": %d, \"tilted\": %d},\n",
+              r.slam_valid, r.slam_lost, r.slam_reinit, r.slam_tilted);
   std::printf("  \"seed_fuser\": {\"averaged\": %d, \"fallback\": %d},\n", r.seed_averaged,
               r.seed_fallback);
-  std::printf("  \"gated_fuser\": {\"fused\": %d, \"rejected\": %d, \"anchors\": %d}\n}\n",
+  std::printf("  \"gated_fuser\": {\"fused\": %d, \"rejected\": %d, \"anchors\": %d},\n",
               r.gated_fused, r.gated_rejected, r.gated_anchors);
+  std::printf("  \"magnetometer_calibrated\": %s,\n  \"magnetometer_note\": \"%s\",\n",
+              r.magnetometer_calibrated ? "true" : "false", json_escape(r.magnetometer_note).c_str());
+  std::printf("  \"attitude_stale_s\": %s,\n  \"warnings\": [", num(r.attitude_stale_s, 3).c_str());
+  for (std::size_t i = 0; i < r.warnings.size(); ++i)
+    std::printf("%s\n    \"%s\"", i ? "," : "", json_escape(r.warnings[i]).c_str());
+  std::printf("%s]\n}\n", r.warnings.empty() ? "" : "\n  ");
 }
 
 void write_svg(const std::filesystem::path& file, const posefuse::CorridorRunResult& r) {

@@ -4,7 +4,9 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "support/run_program.hpp"
 #include "support/temp_dir.hpp"
@@ -19,6 +21,27 @@ std::string json_field(const std::string& json, const std::string& method, const
   const std::size_t at = json.find(tag, m);
   REQUIRE(at != std::string::npos);
   return json.substr(at + tag.size(), json.find_first_of(",}", at + tag.size()) - at - tag.size());
+}
+
+/// The lines of `text` from the first starting with "method" through the
+/// second starting with "gated_fuser" (the corridor table), each with
+/// `prefix` removed and trailing spaces dropped.
+std::vector<std::string> table_block(const std::string& text, const std::string& prefix = "") {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  std::string line;
+  int gated = 0;
+  while (std::getline(in, line) && gated < 2) {
+    while (!line.empty() && (line.back() == ' ' || line.back() == '\r')) line.pop_back();
+    if (line.rfind(prefix, 0) == 0) line = line.substr(prefix.size());
+    else if (prefix.rfind(line, 0) == 0 && line.find_first_not_of(' ') != std::string::npos &&
+             prefix.find_first_not_of(' ', line.size()) == std::string::npos)
+      line.clear();  // the prefix without its trailing spaces: an empty line
+    if (out.empty() && line.rfind("method          loop closure", 0) != 0) continue;
+    out.push_back(line);
+    gated += line.rfind("gated_fuser", 0) == 0;
+  }
+  return out;
 }
 
 }  // namespace
@@ -87,4 +110,65 @@ TEST_CASE("corridor_fusion: bad input exits non-zero with a one-line reason",
   const auto help = posefuse::test::run(exe, "--help", dir);
   CHECK(help.status == 0);
   CHECK(help.out.find("--write-log") != std::string::npos);
+}
+
+TEST_CASE("corridor_fusion: README's seed-001 table and the example's comment are its output",
+          "[fusion][examples][corridor]") {
+  POSEFUSE_REQUIRE_EXAMPLE(exe, "corridor_fusion");
+  posefuse::test::TempDir dir("corridor-example");
+  const auto r = posefuse::test::run(exe, "", dir);
+  REQUIRE(r.status == 0);
+  const auto printed = table_block(r.out);
+  REQUIRE(printed.size() == 12);
+  const std::filesystem::path root = std::filesystem::path(__FILE__).parent_path().parent_path().parent_path();
+  const std::string readme = posefuse::test::slurp(root / "README.md");
+  const std::size_t sec = readme.find("## Seed 001");
+  REQUIRE(sec != std::string::npos);
+  CHECK(table_block(readme.substr(sec)) == printed);
+  const std::string example = posefuse::test::slurp(root / "examples" / "corridor_fusion.cpp");
+  CHECK(table_block(example, "//   ") == printed);
+}
+
+TEST_CASE("corridor_fusion: --json reports warnings, tilted SLAM poses and the magnetometer",
+          "[fusion][examples][corridor]") {
+  POSEFUSE_REQUIRE_EXAMPLE(exe, "corridor_fusion");
+  posefuse::test::TempDir dir("corridor-example");
+  const auto log = dir.path() / "log";
+  const auto clean = posefuse::test::run(exe, "--seed 2 --json --write-log '" + log.string() + "'", dir);
+  REQUIRE(clean.status == 0);
+  CHECK(clean.out.find("\"warnings\": []") != std::string::npos);
+  CHECK(clean.out.find("\"tilted\": 0") != std::string::npos);
+  CHECK(clean.out.find("\"magnetometer_calibrated\": true") != std::string::npos);
+  CHECK(clean.out.find("\"magnetometer_note\": \"horizontal hard/soft-iron") != std::string::npos);
+  CHECK(clean.out.find("\"max_yaw_error_all_deg\": ") != std::string::npos);
+  // The IMU stops halfway (imu.csv cut), ground truth starts 2 m off.
+  for (const char* name : {"imu.csv", "groundtruth.csv"}) {
+    std::istringstream in(posefuse::test::slurp(log / name));
+    std::vector<std::string> lines;
+    for (std::string l; std::getline(in, l);) lines.push_back(l);
+    std::ofstream out(log / name, std::ios::trunc);
+    const bool imu = std::string(name) == "imu.csv";
+    for (std::size_t i = 0; i < (imu ? lines.size() / 2 : lines.size()); ++i) {
+      if (!imu && lines[i][0] != '#') {
+        const std::size_t c = lines[i].find(',');
+        const std::size_t d = lines[i].find(',', c + 1);
+        out << lines[i].substr(0, c + 1) << std::stod(lines[i].substr(c + 1, d - c - 1)) + 2.0
+            << lines[i].substr(d) << '\n';
+      } else {
+        out << lines[i] << '\n';
+      }
+    }
+  }
+  const auto json = posefuse::test::run(exe, "--json --log '" + log.string() + "'", dir);
+  REQUIRE(json.status == 0);
+  INFO(json.out);
+  const std::size_t w = json.out.find("\"warnings\": [");
+  REQUIRE(w != std::string::npos);
+  CHECK(json.out.find("groundtruth.csv: the first pose is (2.00 m", w) != std::string::npos);
+  CHECK(json.out.find("imu.csv: no attitude younger than", w) != std::string::npos);
+  CHECK(json.out.find("\"magnetometer_calibrated\": false") != std::string::npos);
+  const auto table = posefuse::test::run(exe, "--log '" + log.string() + "'", dir);
+  REQUIRE(table.status == 0);
+  CHECK(table.out.find("warning: ") != std::string::npos);
+  CHECK(table.out.find("ground truth in the odometry frame") != std::string::npos);
 }

@@ -47,6 +47,7 @@ TEST_CASE("Corridor: SLAM alone fails at corner 3; the gated fuser completes the
   // Seeds 1-10: the range README states. The seed fuser's 180-degree flip
   // (raw angle averaging near +-180 deg) is counted too (README says how often).
   int seed_fuser_flips = 0, gated_rmse_better = 0;
+  double gated_lo = 1e9, gated_hi = 0, odom_lo = 1e9, odom_hi = 0;
   for (std::uint64_t seed = 1; seed <= 10; ++seed) {
     const auto sim = posefuse::simulate_corridor({}, seed);
     const auto r = posefuse::run_corridor(sim.log);
@@ -83,7 +84,16 @@ TEST_CASE("Corridor: SLAM alone fails at corner 3; the gated fuser completes the
     // The gated fuser never flips; the seed fuser does on some seeds.
     CHECK(m[kGated].max_yaw_error_all_deg < 10.0);
     seed_fuser_flips += m[kSeed].max_yaw_error_all_deg > 170.0;
+    gated_lo = std::min(gated_lo, m[kGated].loop_closure_error_m);
+    gated_hi = std::max(gated_hi, m[kGated].loop_closure_error_m);
+    odom_lo = std::min(odom_lo, m[kOdom].loop_closure_error_m);
+    odom_hi = std::max(odom_hi, m[kOdom].loop_closure_error_m);
   }
+  // README: "0.09-0.98 m ... against 0.23-2.28 m for odometry alone".
+  CHECK(std::round(gated_lo * 100) == 9);
+  CHECK(std::round(gated_hi * 100) == 98);
+  CHECK(std::round(odom_lo * 100) == 23);
+  CHECK(std::round(odom_hi * 100) == 228);
   CHECK(seed_fuser_flips == 6);
   CHECK(gated_rmse_better == 9);  // not seed 9: 0.32 m against odometry's 0.26 m
 }
