@@ -140,3 +140,40 @@ TEST_CASE("Corridor sim: SLAM freezes before corner 3, is lost, and re-initialis
   const double q = std::hypot(it->q[0], it->q[1], it->q[2]);
   CHECK(std::hypot(q, it->q[3]) == Approx(1.0));
 }
+
+TEST_CASE("Corridor sim: an invalid config is rejected, naming the field", "[sim]") {
+  struct Case {
+    void (*set)(CorridorSimConfig&);
+    const char* what;
+  };
+  const Case cases[] = {
+      {[](CorridorSimConfig& c) { c.wheel_rate_hz = 0; }, "wheel_rate_hz must be positive"},
+      {[](CorridorSimConfig& c) { c.imu_rate_hz = -100; }, "imu_rate_hz must be positive"},
+      {[](CorridorSimConfig& c) { c.slam_rate_hz = std::nan(""); }, "slam_rate_hz must be positive"},
+      {[](CorridorSimConfig& c) { c.jitter_s = 0.01; }, "jitter_s must be less than half the sample period of wheel_rate_hz"},
+      {[](CorridorSimConfig& c) { c.jitter_s = 0.005; }, "jitter_s must be less than half the sample period of imu_rate_hz"},  // 100 Hz: dt/2 = 5 ms
+      {[](CorridorSimConfig& c) { c.jitter_s = -0.001; }, "jitter_s must be >= 0"},
+      {[](CorridorSimConfig& c) { c.leg_a_m = 0; }, "leg_a_m must be positive"},
+      {[](CorridorSimConfig& c) { c.cruise_speed_mps = -0.4; }, "cruise_speed_mps must be positive"},
+      {[](CorridorSimConfig& c) { c.wheel_radius_m = 0; }, "wheel_radius_m must be positive"},
+      {[](CorridorSimConfig& c) { c.slip_sigma = -0.01; }, "slip_sigma must be >= 0"},
+      {[](CorridorSimConfig& c) { c.pause_s = -1; }, "pause_s must be >= 0"},
+      {[](CorridorSimConfig& c) { c.complementary_alpha = 1.0; }, "complementary_alpha must lie in (0, 1)"},
+      {[](CorridorSimConfig& c) { c.track_error = -1.0; }, "track_error must be > -1"},
+      {[](CorridorSimConfig& c) { c.disturbance_blobs = -1; }, "disturbance_blobs must be >= 0"},
+      {[](CorridorSimConfig& c) { c.reinit_after_corner3_m = 20; }, "reinit_after_corner3_m must lie within leg 3"},
+      {[](CorridorSimConfig& c) { c.freeze_before_corner3_m = 30; }, "freeze_before_corner3_m must be shorter"},
+  };
+  for (const auto& k : cases) {
+    CorridorSimConfig c;
+    k.set(c);
+    INFO(k.what);
+    CHECK_THROWS_AS(simulate_corridor(c, 1), posefuse::invalid_argument);
+    CHECK_THROWS_WITH(simulate_corridor(c, 1), Catch::Contains(std::string("CorridorSimConfig: ") + k.what));
+  }
+  CHECK_NOTHROW(posefuse::validate(CorridorSimConfig{}));
+  CorridorSimConfig edge;
+  edge.jitter_s = 0.0049;  // just under half of the IMU's 10 ms
+  const auto s = simulate_corridor(edge, 1);
+  for (std::size_t i = 1; i < s.log.imu.size(); ++i) REQUIRE(s.log.imu[i].t_ns > s.log.imu[i - 1].t_ns);
+}

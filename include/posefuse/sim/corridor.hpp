@@ -49,59 +49,9 @@
 
 #include <posefuse/core/angles.hpp>
 #include <posefuse/io/robot_log.hpp>
+#include <posefuse/sim/corridor_config.hpp>
 
 namespace posefuse {
-
-/// Parameters of simulate_corridor(); defaults are the documented scenario.
-struct CorridorSimConfig {
-  double leg_a_m = 14.0;            ///< legs 1→2 and 3→4 (m)
-  double leg_b_m = 9.0;             ///< legs 2→3 and 4→1 (m)
-  double cruise_speed_mps = 0.4;    ///< cruise speed on straights (m/s)
-  double accel_mps2 = 0.3;          ///< straight-line acceleration (m/s²)
-  double turn_rate_radps = 0.6;     ///< peak in-place turn rate (rad/s)
-  double turn_accel_radps2 = 1.0;   ///< turn-rate acceleration (rad/s²)
-  double still_start_s = 3.0;       ///< standstill before moving (s)
-  double still_end_s = 2.0;         ///< standstill after the last turn (s)
-  double pause_s = 0.5;             ///< standstill before and after each turn (s)
-  double wheel_rate_hz = 50;        ///< encoder sample rate (Hz)
-  double imu_rate_hz = 100;         ///< IMU sample rate (Hz)
-  double slam_rate_hz = 15;         ///< SLAM pose rate (Hz)
-  double truth_rate_hz = 100;       ///< ground-truth rate (Hz)
-  double jitter_s = 0.002;          ///< uniform timestamp jitter, ± (s)
-  std::int64_t t0_ns = 1'600'000'000'000'000'000;  ///< clock value of t = 0 (ns)
-  double ticks_per_rev = 1320;      ///< encoder ticks per wheel revolution (robot.txt)
-  double wheel_radius_m = 0.065;    ///< nominal wheel radius (m, robot.txt)
-  double track_width_m = 0.40;      ///< nominal effective track (m, robot.txt)
-  double complementary_alpha = 0.98;  ///< written to robot.txt (seed eq 3-4)
-  double fuser_threshold = 0.01;      ///< written to robot.txt (seed eq 15, m·rad)
-  double radius_error_sigma = 0.001;  ///< relative, fixed per wheel
-  double track_error = 0.015;         ///< true effective track / nominal - 1
-  double track_turn_sigma = 0.01;     ///< relative, per turn
-  double slip_sigma = 0.01;           ///< relative, per encoder increment
-  double accel_noise = 0.05;        ///< accelerometer white noise per sample (m/s²)
-  double accel_bias_sigma = 0.05;   ///< accelerometer constant bias, per axis (m/s²)
-  double gyro_noise = 0.002;        ///< gyro white noise per sample (rad/s)
-  double gyro_bias_sigma = 0.003;   ///< gyro constant bias, per axis (rad/s)
-  double earth_h_uT = 30;           ///< horizontal Earth field (µT)
-  double earth_v_uT = 40;           ///< downward Earth field (µT)
-  double mag_noise_uT = 0.3;        ///< magnetometer white noise (µT)
-  double hard_iron_sigma_uT = 10;   ///< hard-iron offset, per axis (µT)
-  double soft_iron_sigma = 0.05;    ///< soft-iron matrix I + symmetric N(0, σ)
-  double disturbance_uT = 2;        ///< indoor field disturbance per blob, per axis (µT)
-  double disturbance_width_m = 1.5; ///< blob width (m, 1-σ of a Gaussian)
-  int disturbance_blobs = 8;        ///< number of disturbance blobs
-  double slam_init_s = 0.5;                         ///< tracking starts (s)
-  double slam_sigma_xy = 0.02;      ///< white position noise (m)
-  double slam_sigma_yaw = 0.005;    ///< white yaw (and roll/pitch) noise (rad)
-  double slam_drift_xy = 0.03;      ///< Gauss-Markov position drift σ (m)
-  double slam_drift_yaw = 0.009;    ///< Gauss-Markov yaw drift σ (rad)
-  double slam_drift_tau_s = 10;     ///< Gauss-Markov time constant (s)
-  double freeze_before_corner3_m = 1.5;  ///< the pose freezes this far before corner 3
-  double frozen_s = 3.0;                 ///< frozen but reported `tracking` (s)
-  double reinit_after_corner3_m = 3.0;   ///< re-initialisation this far into leg 3
-  double reinit_xy_m = 5.0;         ///< new map frame: x, y uniform in ± this (m)
-  double reinit_z_m = 0.5;          ///< new map frame: z uniform in [0, this] (m)
-};
 
 /// One leg or turn of the drive, for evaluation.
 struct CorridorManoeuvre {
@@ -244,8 +194,10 @@ inline std::array<double, 4> quat_from_zyx(double yaw, double pitch, double roll
 /// @param[in] cfg  scenario and sensor parameters
 /// @param[in] seed RNG seed; the same (cfg, seed) gives the same log
 /// @return the log, the manoeuvres and the SLAM failure times
+/// @throws posefuse::invalid_argument for an invalid config (validate())
 [[nodiscard]] inline CorridorSimulation simulate_corridor(const CorridorSimConfig& cfg,
                                                           std::uint64_t seed) {
+  validate(cfg);
   using detail::Segment;
   using detail::Trapezoid;
   detail::SimRng rng(seed);
