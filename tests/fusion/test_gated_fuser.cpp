@@ -253,3 +253,29 @@ TEMPLATE_TEST_CASE("GatedFuser: stage form in float and double", "[fusion][gated
   CHECK(out.pose.x == Approx(2.5).margin(0.02));
   CHECK(out.cov(0, 0) > T(0));
 }
+
+TEST_CASE("GatedFuser: reset() forgets the distance travelled and the anchor count",
+          "[fusion][gated]") {
+  GatedFuserParams<double> p;
+  p.anchor_samples = 4;
+  p.anchor_min_travel_m = 0.3;
+  GatedFuser<double> f(p);
+  // Drive 2 m straight with SLAM in the world frame: anchors once.
+  for (int k = 0; k <= 40; ++k) {
+    const Pose o{0.05 * k, 0, 0};
+    (void)f.predict(o);
+    (void)f.update_slam(o, false);
+  }
+  REQUIRE(f.anchor_count() == 1);
+  CHECK(f.travelled() == Approx(2.0));
+  f.reset(Pose{}, Eigen::Matrix3d::Identity() * 1e-6);
+  CHECK(f.anchor_count() == 0);
+  CHECK(f.travelled() == 0.0);
+  CHECK_FALSE(f.anchored());
+  // After the reset, standing still never spans anchor_min_travel_m: no anchor.
+  for (int k = 0; k < 10; ++k) {
+    (void)f.predict(Pose{5, 5, 0});
+    CHECK(f.update_slam(Pose{1, 1, 0}, false) == FuserStatus::kAnchoring);
+  }
+  CHECK(f.anchor_count() == 0);
+}

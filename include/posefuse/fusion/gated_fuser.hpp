@@ -201,7 +201,8 @@ class GatedFuser {
   }
 
   /// Restarts at `start` (world frame) with covariance `cov`; forgets the
-  /// odometry reference and any SLAM anchor.
+  /// odometry reference, any SLAM anchor, the distance travelled and the
+  /// anchor count.
   void reset(const Pose& start, const Mat3& cov) noexcept {
     x_ = start;
     a_ = Pose{};
@@ -211,6 +212,8 @@ class GatedFuser {
     anchor_ = AnchorState::kNone;
     n_cand_ = 0;
     rejects_ = 0;
+    travelled_ = 0;
+    anchors_ = 0;
   }
 
   /// Applies the odometry increment since the previous call (the first call
@@ -317,6 +320,8 @@ class GatedFuser {
   [[nodiscard]] Pose odometry_correction() const noexcept {
     return se2_compose(x_, se2_inverse(odom_));
   }
+  /// Odometry distance travelled since construction or reset() (m).
+  [[nodiscard]] T travelled() const noexcept { return travelled_; }
   /// Number of anchors estimated so far (first frame, re-inits, unannounced changes).
   [[nodiscard]] int anchor_count() const noexcept { return anchors_; }
 
