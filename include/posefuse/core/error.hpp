@@ -38,9 +38,16 @@ class io_error : public std::runtime_error {
  private:
   static std::string format(const std::filesystem::path& file, std::size_t line,
                             const std::string& reason) {
+    // Appended piece by piece: `s + ":" + ...` trips GCC 12's -Wrestrict
+    // false positive in optimised builds.
     std::string s = file.string();
-    if (line > 0) s += ":" + std::to_string(line);
-    return s + ": " + reason;
+    if (line > 0) {
+      s.append(":");
+      s.append(std::to_string(line));
+    }
+    s.append(": ");
+    s.append(reason);
+    return s;
   }
   std::filesystem::path file_;
   std::size_t line_;
