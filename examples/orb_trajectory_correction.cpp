@@ -169,13 +169,6 @@ struct EstimateResult {
   std::vector<MethodResult> methods;
 };
 
-std::vector<Eigen::Vector2d> plane_points(const Trajectory& t, Plane plane) {
-  std::vector<Eigen::Vector2d> p;
-  p.reserve(t.size());
-  for (const auto& T : t.poses) p.push_back(project_to_plane(T.translation(), plane));
-  return p;
-}
-
 EstimateResult correct(std::string name, const Trajectory& gt_full, const Trajectory& est_full,
                        const Options& o) {
   EstimateResult r;
@@ -193,8 +186,8 @@ EstimateResult correct(std::string name, const Trajectory& gt_full, const Trajec
     r.estimate = est_full;
   }
   r.estimate = align_trajectory(r.estimate, r.groundtruth, o.alignment).trajectory;
-  r.truth_xy = plane_points(r.groundtruth, o.plane);
-  r.raw_xy = plane_points(r.estimate, o.plane);
+  r.truth_xy = project_to_plane(r.groundtruth, o.plane);
+  r.raw_xy = project_to_plane(r.estimate, o.plane);
   r.rmse_before = rmse_2d(r.truth_xy, r.raw_xy);
 
   MethodResult seed{"seed000", {}, {}, 0};

@@ -1,5 +1,6 @@
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <posefuse/eval/metrics.hpp>
 #include <posefuse/filters/trajectory_correction.hpp>
 #include <posefuse/sim/kitti_like_drive.hpp>
 
@@ -7,14 +8,7 @@ using namespace posefuse;
 
 namespace {
 std::vector<Eigen::Vector2d> plane_points(const Trajectory& t) {
-  std::vector<Eigen::Vector2d> p;
-  for (const auto& T : t.poses) p.push_back(project_to_plane(T.translation(), Plane::kXZ));
-  return p;
-}
-double rmse(const std::vector<Eigen::Vector2d>& a, const std::vector<Eigen::Vector2d>& b) {
-  double s = 0;
-  for (std::size_t i = 0; i < a.size(); ++i) s += (a[i] - b[i]).squaredNorm();
-  return std::sqrt(s / static_cast<double>(a.size()));
+  return project_to_plane(t, Plane::kXZ);
 }
 }  // namespace
 
@@ -74,21 +68,21 @@ TEST_CASE("Constant-velocity corrector and RTS smoother remove jitter, not drift
   std::vector<Eigen::Vector2d> smoothed;
   for (const auto& b : smoothed_beliefs) smoothed.push_back(b.mean.head<2>());
 
-  const double e_raw = rmse(truth, raw);
-  const double e_rts = rmse(truth, smoothed);
+  const double e_raw = rmse_2d(truth, raw);
+  const double e_rts = rmse_2d(truth, smoothed);
   // Without jitter the estimate would be pure drift: the best a smoother can do.
   cfg.jitter_m = 0;
   const auto drift_only = plane_points(sim::make_kitti_like_drive(cfg).estimate);
-  const double e_drift = rmse(truth, drift_only);
-  INFO("raw " << e_raw << " cv " << rmse(truth, filtered) << " rts " << e_rts << " drift-only "
+  const double e_drift = rmse_2d(truth, drift_only);
+  INFO("raw " << e_raw << " cv " << rmse_2d(truth, filtered) << " rts " << e_rts << " drift-only "
               << e_drift);
   CHECK(e_rts < e_raw);
-  CHECK(rmse(truth, filtered) < e_raw);
+  CHECK(rmse_2d(truth, filtered) < e_raw);
   CHECK(e_rts < 1.02 * e_drift);  // jitter gone ...
   CHECK(e_rts > 0.9 * e_drift);   // ... drift stays
   // Smoothing takes the white noise out: the smoothed path is much closer to
   // the jitter-free estimate than the raw one.
-  CHECK(rmse(drift_only, smoothed) < 0.5 * rmse(drift_only, raw));
+  CHECK(rmse_2d(drift_only, smoothed) < 0.5 * rmse_2d(drift_only, raw));
 }
 
 TEST_CASE("RTS smoother: smoothed covariance never exceeds the filtered one",
