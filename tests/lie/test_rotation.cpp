@@ -1,4 +1,4 @@
-// Tests for core/rotation.hpp: ZYX Euler <-> rotation matrix with the
+// Tests for lie/rotation.hpp: ZYX Euler <-> rotation matrix with the
 // gimbal-lock cases of seed 001 eq 11-13, pose matrix -> position + Euler,
 // and SO(3) exp / log / right Jacobian.
 #include <catch2/catch.hpp>
@@ -7,7 +7,7 @@
 #include <cmath>
 #include <numbers>
 #include <posefuse/core/angles.hpp>
-#include <posefuse/core/rotation.hpp>
+#include <posefuse/lie/rotation.hpp>
 #include <random>
 
 using posefuse::EulerZYX;
@@ -31,7 +31,7 @@ Eigen::Matrix<T, 3, 3> Rz(T a) {
 }
 }  // namespace
 
-TEMPLATE_TEST_CASE("Rotation: euler -> R matches hand-worked matrices", "[core][rotation]", float,
+TEMPLATE_TEST_CASE("Rotation: euler -> R matches hand-worked matrices", "[lie][rotation]", float,
                    double) {
   using T = TestType;
   constexpr T h = std::numbers::pi_v<T> / 2;
@@ -57,7 +57,7 @@ TEMPLATE_TEST_CASE("Rotation: euler -> R matches hand-worked matrices", "[core][
 }
 
 TEMPLATE_TEST_CASE("Rotation: round trip euler -> R -> euler away from gimbal lock",
-                   "[core][rotation]", float, double) {
+                   "[lie][rotation]", float, double) {
   using T = TestType;
   std::mt19937 rng(1234);
   std::uniform_real_distribution<double> ang(-3.1, 3.1);
@@ -73,7 +73,7 @@ TEMPLATE_TEST_CASE("Rotation: round trip euler -> R -> euler away from gimbal lo
 }
 
 TEMPLATE_TEST_CASE("Rotation: gimbal lock at exactly +-90 deg pitch (eq 13-a, 13-b)",
-                   "[core][rotation]", float, double) {
+                   "[lie][rotation]", float, double) {
   using T = TestType;
   constexpr T h = std::numbers::pi_v<T> / 2;
   // Hand-built: yaw 0.3, pitch +90, roll 0: Rz(0.3) Ry(90) with Ry(90) = [[0,0,1],[0,1,0],[-1,0,0]]
@@ -112,7 +112,7 @@ TEMPLATE_TEST_CASE("Rotation: gimbal lock at exactly +-90 deg pitch (eq 13-a, 13
   }
 }
 
-TEMPLATE_TEST_CASE("Rotation: near gimbal lock the result still reproduces R", "[core][rotation]",
+TEMPLATE_TEST_CASE("Rotation: near gimbal lock the result still reproduces R", "[lie][rotation]",
                    float, double) {
   using T = TestType;
   constexpr T h = std::numbers::pi_v<T> / 2;
@@ -139,7 +139,7 @@ TEMPLATE_TEST_CASE("Rotation: near gimbal lock the result still reproduces R", "
   CHECK(b.yaw == Approx(e.yaw).margin((std::is_same_v<T, float> ? T(1e-4) : T(1e-8))));
 }
 
-TEMPLATE_TEST_CASE("Rotation: position_and_euler reads a pose matrix (eq 11)", "[core][rotation]",
+TEMPLATE_TEST_CASE("Rotation: position_and_euler reads a pose matrix (eq 11)", "[lie][rotation]",
                    float, double) {
   using T = TestType;
   const EulerZYX<T> e{T(0.1), T(-0.2), T(2.0)};
@@ -161,7 +161,7 @@ TEMPLATE_TEST_CASE("Rotation: position_and_euler reads a pose matrix (eq 11)", "
 }
 
 TEMPLATE_TEST_CASE("Rotation: SO(3) exp and log are inverse, also near 0 and pi",
-                   "[core][rotation]", float, double) {
+                   "[lie][rotation]", float, double) {
   using T = TestType;
   using V = Eigen::Matrix<T, 3, 1>;
   const T t = std::is_same_v<T, float> ? T(2e-5) : T(1e-12);
@@ -184,7 +184,7 @@ TEMPLATE_TEST_CASE("Rotation: SO(3) exp and log are inverse, also near 0 and pi"
   }
 }
 
-TEST_CASE("Rotation: SO(3) right Jacobian matches central differences", "[core][rotation]") {
+TEST_CASE("Rotation: SO(3) right Jacobian matches central differences", "[lie][rotation]") {
   using V = Eigen::Vector3d;
   for (const V& phi : {V(0.3, -0.2, 0.5), V(1e-4, 2e-4, -1e-4), V(0, 0, 0), V(2.0, 1.0, -0.5)}) {
     const Eigen::Matrix3d Jr = posefuse::so3_right_jacobian(phi);

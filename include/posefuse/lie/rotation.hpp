@@ -2,7 +2,8 @@
 /// @file
 /// Rotations in 3-D: ZYX Euler angles <-> rotation matrices with the
 /// gimbal-lock handling of seed 001 eq 11-13, pose matrix -> position and
-/// Euler angles, and the SO(3) exponential / logarithm.
+/// Euler angles, and matrix-valued shorthands for the SO(3) exponential /
+/// logarithm / right Jacobian (implemented by lie/so3.hpp's SO3).
 ///
 /// Convention (REP-103, seed 001 eq 11): a rotation matrix \f$ R \f$ maps
 /// vectors from the body frame to the world frame, and
@@ -21,6 +22,7 @@
 #include <concepts>
 #include <limits>
 #include <numbers>
+#include <posefuse/lie/so3.hpp>
 
 namespace posefuse {
 
@@ -119,85 +121,39 @@ template <std::floating_point T>
   return position_and_euler<T>(T_w_b.matrix(), lock_tol);
 }
 
-/// The skew-symmetric (hat) matrix \f$ [v]_\times \f$ with \f$ [v]_\times w = v \times w \f$.
+/// The skew-symmetric (hat) matrix \f$ [v]_\times \f$ with \f$ [v]_\times w = v \times w \f$
+/// (SO3::hat).
 template <std::floating_point T>
 [[nodiscard]] inline Eigen::Matrix<T, 3, 3> skew(const Eigen::Matrix<T, 3, 1>& v) {
-  Eigen::Matrix<T, 3, 3> S;
-  S << T(0), -v.z(), v.y(), v.z(), T(0), -v.x(), -v.y(), v.x(), T(0);
-  return S;
+  return SO3<T>::hat(v);
 }
 
-namespace detail {
-/// Below this angle the SO(3) coefficient functions use their Taylor series
-/// (eps^(1/8): 0.011 for double, 0.14 for float), where the closed forms
-/// would lose digits to cancellation.
-template <std::floating_point T>
-[[nodiscard]] inline T so3_series_threshold() noexcept {
-  return std::sqrt(std::sqrt(std::sqrt(std::numeric_limits<T>::epsilon())));
-}
-}  // namespace detail
-
-/// SO(3) exponential (Rodrigues): the rotation by |phi| rad about phi/|phi|.
+/// SO(3) exponential (Rodrigues): the rotation matrix of the rotation by
+/// |phi| rad about phi/|phi| (SO3::exp; accurate down to |phi| = 0).
 template <std::floating_point T>
 [[nodiscard]] inline Eigen::Matrix<T, 3, 3> so3_exp(const Eigen::Matrix<T, 3, 1>& phi) {
-  const T th2 = phi.squaredNorm();
-  const T th = std::sqrt(th2);
-  const Eigen::Matrix<T, 3, 3> W = skew(phi);
-  T a, b;  // sin(th)/th, (1-cos th)/th^2
-  if (th < detail::so3_series_threshold<T>()) {
-    a = T(1) - th2 / T(6) + th2 * th2 / T(120);
-    b = T(0.5) - th2 / T(24) + th2 * th2 / T(720);
-  } else {
-    a = std::sin(th) / th;
-    b = (T(1) - std::cos(th)) / th2;
-  }
-  return Eigen::Matrix<T, 3, 3>::Identity() + a * W + b * W * W;
+  return SO3<T>::exp(phi).matrix();
 }
 
-/// SO(3) logarithm: the rotation vector (rad) of R, with |result| in [0, pi].
-/// The angle comes from atan2(sin, cos), accurate at every angle; beyond 90°
-/// the axis is taken from the symmetric part of R, so it stays accurate near pi.
-/// @param[in] R rotation matrix, assumed orthonormal
+/// SO(3) logarithm: the rotation vector (rad) of R, with |result| in [0, pi]
+/// (SO3's matrix constructor, then SO3::log through the quaternion, accurate
+/// at every angle including pi).
+/// @param[in] R rotation matrix, orthonormal within SO3::kDefaultOrthonormalityTolerance
+/// @throws posefuse::invalid_argument when R is not finite, not orthonormal or a reflection
 template <class Derived>
 [[nodiscard]] inline Eigen::Matrix<typename Derived::Scalar, 3, 1> so3_log(
     const Eigen::MatrixBase<Derived>& R) {
   using T = typename Derived::Scalar;
-  using V = Eigen::Matrix<T, 3, 1>;
-  using M3 = Eigen::Matrix<T, 3, 3>;
-  const M3 M = R;
-  const T cos_th = (M.trace() - T(1)) / T(2);
-  const V vee{M(2, 1) - M(1, 2), M(0, 2) - M(2, 0), M(1, 0) - M(0, 1)};  // 2 sin(th) axis
-  const T sin_th = vee.norm() / T(2);
-  const T th = std::atan2(sin_th, cos_th);
-  if (th < detail::so3_series_threshold<T>()) {
-    const T th2 = th * th;  // th / (2 sin th) = (1 + th^2/6 + 7 th^4/360) / 2
-    return (T(0.5) + th2 / T(12) + T(7) * th2 * th2 / T(720)) * vee;
-  }
-  if (cos_th >= T(0)) return (th / (T(2) * sin_th)) * vee;
-  // Beyond 90 deg: R + R^T = 2 cos th I + 2 (1 - cos th) a a^T; use the largest column.
-  const M3 B = (M + M.transpose() - T(2) * cos_th * M3::Identity()) / (T(2) * (T(1) - cos_th));
-  Eigen::Index k = 0;
-  B.diagonal().maxCoeff(&k);
-  V axis = B.col(k) / std::sqrt(B(k, k));
-  if (axis.dot(vee) < T(0)) axis = -axis;
-  return th * axis.normalized();
+  static_assert(Derived::RowsAtCompileTime == 3 && Derived::ColsAtCompileTime == 3,
+                "posefuse: so3_log needs a 3x3 matrix");
+  return SO3<T>(typename SO3<T>::Matrix(R)).log();
 }
 
-/// Right Jacobian of SO(3): \f$ \exp(\phi + \delta) \approx \exp(\phi) \exp(J_r(\phi) \delta) \f$.
+/// Right Jacobian of SO(3): \f$ \exp(\phi + \delta) \approx \exp(\phi) \exp(J_r(\phi) \delta) \f$
+/// (SO3::right_jacobian, Solà et al. 2018 eq 143).
 template <std::floating_point T>
 [[nodiscard]] inline Eigen::Matrix<T, 3, 3> so3_right_jacobian(const Eigen::Matrix<T, 3, 1>& phi) {
-  const T th2 = phi.squaredNorm();
-  const T th = std::sqrt(th2);
-  const Eigen::Matrix<T, 3, 3> W = skew(phi);
-  T a, b;  // (1 - cos th)/th^2, (th - sin th)/th^3
-  if (th < detail::so3_series_threshold<T>()) {
-    a = T(0.5) - th2 / T(24) + th2 * th2 / T(720);
-    b = T(1) / T(6) - th2 / T(120) + th2 * th2 / T(5040);
-  } else {
-    a = (T(1) - std::cos(th)) / th2;
-    b = (th - std::sin(th)) / (th2 * th);
-  }
-  return Eigen::Matrix<T, 3, 3>::Identity() - a * W + b * W * W;
+  return SO3<T>::right_jacobian(phi);
 }
 
 }  // namespace posefuse
