@@ -1,8 +1,9 @@
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <limits>
 #include <posefuse/eval/metrics.hpp>
-#include <posefuse/filters/trajectory_correction.hpp>
-#include <posefuse/sim/kitti_like_drive.hpp>
+#include <apps/trajectory_correction.hpp>
+#include <apps/sim/kitti_like_drive.hpp>
 
 using namespace posefuse;
 
@@ -23,7 +24,7 @@ TEST_CASE("Seed 000 corrector returns its input, for any R and Q", "[filters][se
                                               Eigen::Matrix2d::Identity());
       double max_dev = 0;
       for (std::size_t i = 0; i < drive.estimate.size(); ++i) {
-        const CorrectedPoint c = corrector({drive.estimate.stamps[i], drive.estimate.poses[i]});
+        const CorrectedPoint c = corrector({drive.estimate.t_s[i], drive.estimate.poses[i]});
         REQUIRE(c.status == FilterStatus::kApplied);
         max_dev = std::max(max_dev, (c.p - raw[i]).cwiseAbs().maxCoeff());
       }
@@ -63,7 +64,7 @@ TEST_CASE("Constant-velocity corrector and RTS smoother remove jitter, not drift
   auto cv = make_constant_velocity_corrector(Plane::kXZ, 1.0, cfg.jitter_m);
   std::vector<Eigen::Vector2d> filtered;
   for (std::size_t i = 0; i < drive.estimate.size(); ++i)
-    filtered.push_back(cv({drive.estimate.stamps[i], drive.estimate.poses[i]}).p);
+    filtered.push_back(cv({drive.estimate.t_s[i], drive.estimate.poses[i]}).p);
   const auto smoothed_beliefs = rts_smooth(cv.stage<1>().history());
   std::vector<Eigen::Vector2d> smoothed;
   for (const auto& b : smoothed_beliefs) smoothed.push_back(b.mean.head<2>());
@@ -98,4 +99,56 @@ TEST_CASE("RTS smoother: smoothed covariance never exceeds the filtered one",
   }
   // The last smoothed belief is the last filtered one.
   CHECK((s.back().mean - run.back().filtered_mean).norm() == 0.0);
+}
+
+TEST_CASE("Constant-velocity filter: a prediction that is not applied is reported, and the "
+          "smoother gets no stale Jacobian",
+          "[filters][cv][rts]") {
+  ConstantVelocityFilter f(0.5, 0.3), g(0.5, 0.3);  // g never sees the bad frame
+  for (const double t : {0.0, 0.1, 0.2}) {
+    REQUIRE(f({t, Eigen::Vector2d(t, 0.5 * t)}).status == FilterStatus::kApplied);
+    REQUIRE(g({t, Eigen::Vector2d(t, 0.5 * t)}).status == FilterStatus::kApplied);
+  }
+  const Eigen::Vector4d belief = f.history().back().filtered_mean;
+  const Eigen::Matrix4d cov = f.history().back().filtered_cov;
+  // Time goes backwards: the prediction is refused (dt < 0) and no update is tried.
+  const CorrectedPoint back = f({0.15, Eigen::Vector2d(5.0, 5.0)});
+  CHECK(back.status == FilterStatus::kInvalidInput);
+  CHECK(back.p == belief.head<2>());  // the previous belief, not the fix
+  REQUIRE(f.history().size() == 4);
+  const auto& rec = f.history()[3];
+  CHECK(rec.F == Eigen::Matrix4d::Identity());  // "no change", not the last applied F
+  CHECK(rec.predicted_mean == belief);
+  CHECK(rec.filtered_mean == belief);
+  CHECK(rec.filtered_cov == cov);
+  // The next frame predicts from the belief's time (0.2 s), exactly as if the
+  // bad frame had not been there.
+  const CorrectedPoint a = f({0.3, Eigen::Vector2d(0.3, 0.15)});
+  const CorrectedPoint b = g({0.3, Eigen::Vector2d(0.3, 0.15)});
+  REQUIRE(a.status == FilterStatus::kApplied);
+  CHECK(a.p == b.p);
+  CHECK(a.P == b.P);
+  CHECK(f.history()[4].F == g.history()[3].F);
+  CHECK(f.history()[4].F != Eigen::Matrix4d::Identity());
+  // The smoother runs over the recorded "no change" step.
+  const auto s = rts_smooth(f.history());
+  REQUIRE(s.size() == 5);
+  for (const auto& x : s) CHECK(x.mean.allFinite());
+  // The refused frame's smoothed belief is that of the frame before it (F = I, no update).
+  CHECK((s[3].mean - s[2].mean).norm() < 1e-12);
+}
+
+TEST_CASE("Seed 000 filter: a prediction that is not applied is reported", "[filters][seed000]") {
+  DisplacementEkf ekf(Eigen::Matrix2d::Identity() * 0.01, Eigen::Matrix2d::Identity() * 0.25,
+                      Eigen::Matrix2d::Identity());
+  DisplacementControl control;
+  (void)ekf(control({0.0, Eigen::Vector2d(1, 2)}));
+  const CorrectedPoint ok = ekf(control({0.1, Eigen::Vector2d(1.5, 2)}));
+  REQUIRE(ok.status == FilterStatus::kApplied);
+  CorrectorStep bad = control({0.2, Eigen::Vector2d(2, 2)});
+  bad.u.x() = std::numeric_limits<double>::infinity();
+  const CorrectedPoint c = ekf(bad);
+  CHECK(c.status != FilterStatus::kApplied);
+  CHECK(c.p == ok.p);  // state untouched
+  CHECK(c.P == ok.P);
 }

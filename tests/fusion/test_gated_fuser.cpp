@@ -4,9 +4,14 @@
 #include <Eigen/LU>
 #include <cmath>
 #include <numbers>
+#include <random>
+#include <string>
+#include <vector>
 #include <posefuse/core/pipeline.hpp>
 #include <posefuse/fusion/gated_fuser.hpp>
 
+using posefuse::FilterStatus;
+using posefuse::FuserGate;
 using posefuse::FuserStatus;
 using posefuse::GatedFuser;
 using posefuse::GatedFuserParams;
@@ -54,6 +59,12 @@ TEST_CASE("GatedFuser: SE(2) helpers", "[fusion][gated]") {
   CHECK(back.x == Approx(a.x));
   CHECK(back.y == Approx(a.y));
   CHECK(back.theta == Approx(a.theta));
+  // They are thin wrappers over SE2.
+  const posefuse::SE2d c2 = posefuse::as_se2(a) * posefuse::as_se2(b);
+  CHECK(c.x == c2.x());
+  CHECK(c.y == c2.y());
+  CHECK(c.theta == c2.angle());
+  CHECK(c.theta == Approx(posefuse::wrap_angle(2.5 - 3.0)));
 }
 
 TEST_CASE("GatedFuser: fuse_poses is the information-weighted mean", "[fusion][gated]") {
@@ -83,7 +94,7 @@ TEST_CASE("GatedFuser: the first SLAM poses anchor the map frame, then SLAM is f
   int fused = 0, anchored_at = -1;
   for (int k = 0; k <= 300; ++k) {
     const double s = 0.02 * k;
-    REQUIRE(f.predict(drifting_odometry(s)) == FuserStatus::kPredicted);
+    REQUIRE(f.predict(drifting_odometry(s)) == FilterStatus::kApplied);
     const Pose z = posefuse::se2_compose(posefuse::se2_inverse(T_wm), circle(s));
     const FuserStatus st = f.update_slam(z, false);
     if (anchored_at < 0) CHECK((st == FuserStatus::kAnchoring || st == FuserStatus::kAnchored));
@@ -197,7 +208,14 @@ TEST_CASE("GatedFuser: separate gates reject position or heading alone; Mahalano
       CHECK(pos == FuserStatus::kRejectedPosition);
       CHECK(head == FuserStatus::kRejectedHeading);
     }
+    // One step status (the Ekf's), the gate in its own field.
+    CHECK(pos.step == FilterStatus::kGated);
+    CHECK(head.step == FilterStatus::kGated);
+    CHECK(pos.rejected_by != FuserGate::kNone);
+    CHECK(posefuse::is_rejection(head));
     CHECK(ok == FuserStatus::kFused);
+    CHECK(ok.step == FilterStatus::kApplied);
+    CHECK(ok.rejected_by == FuserGate::kNone);
   }
 }
 
@@ -209,13 +227,25 @@ TEST_CASE("GatedFuser: heading updates and non-finite input", "[fusion][gated]")
   CHECK(f.update_heading(0.21, 0.05) == FuserStatus::kFused);
   CHECK(f.covariance()(2, 2) < var0);
   CHECK(f.pose().theta > 0.2);
-  CHECK(f.update_heading(0.2 + kPi / 2, 0.01) == FuserStatus::kRejectedHeading);
+  const FuserStatus rej = f.update_heading(0.2 + kPi / 2, 0.01);
+  CHECK(rej == FuserStatus::kRejectedHeading);
+  CHECK(rej.rejected_by == FuserGate::kHeading);
+  // Across ±π the residual wraps: 179° measured at a heading near -179°.
+  posefuse::GatedFuser<double> g;
+  g.reset(Pose{0, 0, -179 * kPi / 180}, Eigen::Matrix3d::Identity() * 0.01);
+  REQUIRE(g.update_heading(179 * kPi / 180, 0.05) == FuserStatus::kFused);
+  CHECK(std::abs(g.pose().theta) > 179 * kPi / 180);  // moved through ±180°, not through 0
   const Pose before = f.pose();
+  const Eigen::Matrix3d P_before = f.covariance();
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  CHECK(f.predict({nan, 0, 0}) == FuserStatus::kNonFinite);
+  CHECK(f.predict({nan, 0, 0}) == FilterStatus::kNonFinite);
   CHECK(f.update_slam({0, nan, 0}, false) == FuserStatus::kNonFinite);
   CHECK(f.update_heading(nan, 0.1) == FuserStatus::kNonFinite);
+  CHECK(f.update_heading(0.2, 0.0) == FilterStatus::kInvalidInput);
+  CHECK(f.update_heading(0.2, -0.1).step == FilterStatus::kInvalidInput);
   CHECK(f.pose().x == before.x);
+  CHECK(f.pose().theta == before.theta);
+  CHECK(f.covariance() == P_before);
 }
 
 TEST_CASE("GatedFuser: invalid parameters throw", "[fusion][gated]") {
@@ -250,8 +280,16 @@ TEMPLATE_TEST_CASE("GatedFuser: stage form in float and double", "[fusion][gated
     out = f(in);
   }
   CHECK(out.slam_status == FuserStatus::kFused);
+  CHECK(out.odom_status == FilterStatus::kApplied);
   CHECK(out.pose.x == Approx(2.5).margin(0.02));
   CHECK(out.cov(0, 0) > T(0));
+  // Without a SLAM pose there is no SLAM status.
+  typename GatedFuser<T>::Input odom_only;
+  odom_only.odom = {T(2.6), T(0), T(0)};
+  out = f(odom_only);
+  CHECK(out.odom_status == FilterStatus::kApplied);
+  CHECK_FALSE(out.slam_status.has_value());
+  CHECK(out.pose.x == Approx(2.6).margin(0.02));
 }
 
 TEST_CASE("GatedFuser: reset() forgets the distance travelled and the anchor count",
@@ -278,4 +316,140 @@ TEST_CASE("GatedFuser: reset() forgets the distance travelled and the anchor cou
     CHECK(f.update_slam(Pose{1, 1, 0}, false) == FuserStatus::kAnchoring);
   }
   CHECK(f.anchor_count() == 0);
+  // A covariance that is not one is refused, and the fuser keeps its state.
+  Eigen::Matrix3d bad = Eigen::Matrix3d::Identity();
+  bad(0, 1) = 2.0;
+  bad(1, 0) = 2.0;  // symmetric, indefinite
+  const Pose kept = f.pose();
+  const Eigen::Matrix3d kept_cov = f.covariance();
+  CHECK_THROWS_AS(f.reset(Pose{1, 2, 3}, bad), posefuse::invalid_argument);
+  CHECK(f.pose().x == kept.x);
+  CHECK(f.covariance() == kept_cov);
+}
+
+TEST_CASE("GatedFuser: predicted covariance matches Monte Carlo propagation on a curve",
+          "[fusion][gated][odometry]") {
+  // Noise-free odometry (all odometry sigmas 0) along a left-turning arc:
+  // the covariance then comes from the initial uncertainty alone, carried by
+  // the motion model's Jacobian. Its position-heading terms (the lever arm of
+  // a heading error) must agree with propagating samples through exact SE(2)
+  // composition; a sign error in the heading column of F flips them.
+  GatedFuserParams<double> p;
+  p.odom_xy_sigma_per_sqrt_m = 0;
+  p.odom_theta_sigma_per_sqrt_m = 0;
+  p.odom_theta_sigma_per_sqrt_rad = 0;
+  GatedFuser<double> f(p);
+  const Pose start{1.0, -0.5, 2.8};  // heading near +π; the arc crosses it
+  Eigen::Matrix3d P0;
+  P0 << 4e-4, 1e-4, 0, 1e-4, 9e-4, 2e-4, 0, 2e-4, 1e-3;
+  f.reset(start, P0);
+  std::vector<Pose> odom;
+  Pose o{0, 0, 0};
+  for (int k = 0; k <= 40; ++k) {
+    odom.push_back(o);
+    o = posefuse::se2_compose(o, Pose{0.1, 0.0, 0.03});
+  }
+  for (const Pose& ok : odom) REQUIRE(f.predict(ok) == FilterStatus::kApplied);
+
+  std::mt19937 rng(7);
+  std::normal_distribution<double> n(0.0, 1.0);
+  const Eigen::Matrix3d L = P0.llt().matrixL();
+  const posefuse::SE2d delta = posefuse::as_se2(odom.front()).between(posefuse::as_se2(odom.back()));
+  constexpr int kSamples = 40000;
+  std::vector<Pose> ends;
+  ends.reserve(kSamples);
+  for (int i = 0; i < kSamples; ++i) {
+    const Eigen::Vector3d e = L * Eigen::Vector3d(n(rng), n(rng), n(rng));
+    ends.push_back(posefuse::as_planar_pose(posefuse::as_se2(start.plus(e)) * delta));
+  }
+  const Pose mean_end = posefuse::as_planar_pose(posefuse::as_se2(start) * delta);
+  Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
+  for (const Pose& y : ends) {
+    const Eigen::Vector3d d = y.minus(mean_end);
+    C += d * d.transpose() / double(kSamples);
+  }
+  const Eigen::Matrix3d& P = f.covariance();
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      INFO("entry (" << i << ", " << j << "): fuser " << P(i, j) << ", Monte Carlo " << C(i, j));
+      CHECK(std::abs(P(i, j) - C(i, j)) < 0.03 * std::sqrt(C(i, i) * C(j, j)));
+    }
+  // The lever arm is long here: the position-heading covariance comes from
+  // the heading error, not from P0 (whose P0(0, 2) = 0, P0(1, 2) = 2e-4).
+  INFO("P(0, 2) = " << P(0, 2) << ", P(1, 2) = " << P(1, 2));
+  CHECK(std::hypot(C(0, 2), C(1, 2)) > 10 * std::hypot(P0(0, 2), P0(1, 2)));
+  CHECK(f.pose().minus(mean_end).norm() < 1e-9);
+}
+
+TEST_CASE("GatedFuser: its prediction and SLAM update are Ekf steps of the planar models",
+          "[fusion][gated]") {
+  // The fuser, and an Ekf<Se2Odometry> driven by hand with the same models,
+  // agree bit for bit once the map frame is anchored at the identity.
+  GatedFuserParams<double> p;
+  p.anchor_samples = 1;
+  p.anchor_min_travel_m = 0;
+  GatedFuser<double> f(p);
+  (void)f.predict({0, 0, 0});
+  REQUIRE(f.update_slam({0, 0, 0}, false) == FuserStatus::kAnchored);
+  REQUIRE(f.map_in_world().x == 0.0);
+  REQUIRE(f.map_in_world().theta == 0.0);
+  posefuse::Ekf<posefuse::Se2Odometry<double>> ekf{posefuse::Se2Odometry<double>(
+      {p.odom_xy_sigma_per_sqrt_m, p.odom_theta_sigma_per_sqrt_m, p.odom_theta_sigma_per_sqrt_rad})};
+  ekf.reset(f.pose(), f.covariance());
+  const auto slam = posefuse::PlanarPoseFix<double>::from_sigmas(p.slam_xy_sigma_m,
+                                                                 p.slam_theta_sigma_rad);
+  Pose prev{0, 0, 0};
+  for (int k = 1; k <= 60; ++k) {
+    const Pose o = circle(0.05 * k);
+    REQUIRE(f.predict(o) == FilterStatus::kApplied);
+    REQUIRE(ekf.predict(posefuse::as_se2(prev).between(posefuse::as_se2(o)), 0.0) ==
+            FilterStatus::kApplied);
+    prev = o;
+    REQUIRE(f.pose().x == ekf.state().x);
+    REQUIRE(f.covariance() == ekf.covariance());
+    if (k % 3 == 0) {
+      const Pose z{o.x + 0.01, o.y - 0.02, posefuse::wrap_angle(o.theta + 0.005)};
+      REQUIRE(f.update_slam(z, false) == FuserStatus::kFused);
+      const Pose zw = posefuse::as_planar_pose(posefuse::as_se2(f.map_in_world()) *
+                                               posefuse::as_se2(z));
+      REQUIRE(ekf.update_with(slam, zw));
+      REQUIRE(f.pose().x == ekf.state().x);
+      REQUIRE(f.pose().theta == ekf.state().theta);
+      REQUIRE(f.covariance() == ekf.covariance());
+    }
+  }
+  CHECK(&f.filter().covariance() == &f.covariance());
+}
+
+TEST_CASE("GatedFuser: status fields and names", "[fusion][gated]") {
+  CHECK(FuserStatus::kFused.applied());
+  CHECK_FALSE(FuserStatus::kAnchoring.applied());
+  CHECK(FuserStatus::kAnchoring.anchor == posefuse::AnchorEvent::kCollecting);
+  CHECK(FuserStatus::kAnchored.anchor == posefuse::AnchorEvent::kAnchored);
+  CHECK(FuserStatus::kSingularInnovation.step == FilterStatus::kNotPositiveDefinite);
+  CHECK(FuserStatus(FilterStatus::kNonFinite) == FuserStatus::kNonFinite);
+  CHECK(FuserStatus::kRejectedPosition != FuserStatus::kRejectedHeading);
+  for (auto g : {FuserGate::kNone, FuserGate::kPosition, FuserGate::kHeading, FuserGate::kJoint})
+    CHECK(std::string(posefuse::to_string(g)) != "unknown");
+  for (auto e : {posefuse::AnchorEvent::kNone, posefuse::AnchorEvent::kCollecting,
+                 posefuse::AnchorEvent::kAnchored})
+    CHECK(std::string(posefuse::to_string(e)) != "unknown");
+}
+
+TEST_CASE("GatedFuser: fuse_poses is one Ekf update; bad covariances throw", "[fusion][gated]") {
+  const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() * 0.01;
+  const Pose a{1, 2, 0.1}, b{1.2, 1.8, 0.3};
+  const auto f = posefuse::fuse_poses(a, P, b, P);
+  CHECK(f.pose.x == Approx(1.1));
+  CHECK(f.pose.theta == Approx(0.2));
+  CHECK((f.cov - P / 2).cwiseAbs().maxCoeff() < 1e-15);
+  // Pa + Pb singular: NaN, as documented.
+  Eigen::Matrix3d Z = Eigen::Matrix3d::Zero();
+  const auto s = posefuse::fuse_poses(a, Z, b, Z);
+  CHECK(std::isnan(s.pose.x));
+  CHECK(std::isnan(s.cov(0, 0)));
+  Eigen::Matrix3d bad = P;
+  bad(2, 2) = -1;
+  CHECK_THROWS_AS(posefuse::fuse_poses(a, bad, b, P), posefuse::invalid_argument);
+  CHECK_THROWS_AS(posefuse::fuse_poses(a, P, b, bad), posefuse::invalid_argument);
 }

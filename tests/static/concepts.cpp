@@ -4,9 +4,12 @@
 #include <posefuse/core/pipeline.hpp>
 #include <posefuse/filters/ekf.hpp>
 #include <posefuse/models/constant_velocity.hpp>
+#include <posefuse/models/heading_fix.hpp>
 #include <posefuse/models/planar_displacement.hpp>
 #include <posefuse/models/planar_pose.hpp>
+#include <posefuse/models/planar_pose_fix.hpp>
 #include <posefuse/models/position.hpp>
+#include <posefuse/models/se2_odometry.hpp>
 
 namespace {
 using namespace posefuse;
@@ -58,6 +61,54 @@ struct MixedScalars {
   Eigen::Matrix2f noise() const { return Eigen::Matrix2f::Identity(); }
 };
 static_assert(!MeasurementModel<MixedScalars>);
+
+// Noise may depend on the state: noise(const State&) instead of noise().
+struct StateDependentNoise {
+  using State = Eigen::Vector2d;
+  using Measurement = Eigen::Vector2d;
+  Measurement predict(const State& x) const { return x; }
+  Eigen::Matrix2d jacobian(const State&) const { return Eigen::Matrix2d::Identity(); }
+  Eigen::Matrix2d noise(const State& x) const { return Eigen::Matrix2d::Identity() * x.norm(); }
+};
+static_assert(MeasurementModel<StateDependentNoise>);
+static_assert(has_state_dependent_noise_v<StateDependentNoise>);
+static_assert(!has_state_dependent_noise_v<PositionFix<2>>);
+
+struct NoNoise {
+  using State = Eigen::Vector2d;
+  using Measurement = Eigen::Vector2d;
+  Measurement predict(const State& x) const { return x; }
+  Eigen::Matrix2d jacobian(const State&) const { return Eigen::Matrix2d::Identity(); }
+};
+static_assert(!MeasurementModel<NoNoise>);
+
+struct NoiseOfWrongArgument {
+  using State = Eigen::Vector2d;
+  using Measurement = Eigen::Vector2d;
+  Measurement predict(const State& x) const { return x; }
+  Eigen::Matrix2d jacobian(const State&) const { return Eigen::Matrix2d::Identity(); }
+  Eigen::Matrix2d noise(const PlanarPose<double>&) const { return Eigen::Matrix2d::Identity(); }
+};
+static_assert(!MeasurementModel<NoiseOfWrongArgument>);
+
+// The planar models of the fusion layer.
+static_assert(MotionModel<Se2Odometry<double>>);
+static_assert(MotionModel<Se2Odometry<float>>);
+static_assert(MeasurementModelFor<PlanarPoseFix<double>, PlanarPose<double>>);
+static_assert(MeasurementModelFor<HeadingFix<float>, PlanarPose<float>>);
+static_assert(has_identity_jacobian_v<PlanarPoseFix<double>>);
+static_assert(is_time_invariant_v<HeadingFix<double>>);
+
+// Gates: a number, or a functor of (r, S) or (r, S, nis) returning bool.
+using Innov3 = Eigen::Vector3d;
+using InnovCov3 = Eigen::Matrix3d;
+static_assert(InnovationGate<double, PlanarPoseFix<double>>);
+static_assert(InnovationGate<bool (*)(const Innov3&, const InnovCov3&), PlanarPoseFix<double>>);
+static_assert(
+    InnovationGate<bool (*)(const Innov3&, const InnovCov3&, double), PlanarPoseFix<double>>);
+static_assert(!InnovationGate<bool (*)(const Eigen::Vector2d&), PlanarPoseFix<double>>);
+static_assert(!InnovationGate<const char*, PlanarPoseFix<double>>);
+static_assert(!InnovationGate<bool, PlanarPoseFix<double>>);  // not a threshold
 
 // Filters are fixed-size all the way down.
 using Seed000 = Ekf<PlanarDisplacement<double>, PositionFix<2>>;

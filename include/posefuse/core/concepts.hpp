@@ -11,7 +11,8 @@
 /// * A **motion model** names its `State` and `Control` and gives
 ///   \f$ f(x, u, \Delta t) \f$, its Jacobian \f$ J_{f,x} \f$ and the process noise.
 /// * A **measurement model** names its `State` and `Measurement` and gives
-///   \f$ h(x) \f$, its Jacobian \f$ J_{h,x} \f$ and the measurement noise.
+///   \f$ h(x) \f$, its Jacobian \f$ J_{h,x} \f$ and the measurement noise,
+///   `noise()` or, when it depends on the state, `noise(const State&)`.
 ///
 /// Every header that defines a model ends with a `static_assert` of the
 /// matching concept. For readable diagnostics, `check_motion_model<M>()` and
@@ -146,7 +147,23 @@ using MeasurementJacobianOf = Eigen::Matrix<ScalarOf<typename H::State>,
                                             DimOf<typename H::Measurement>,
                                             DimOf<typename H::State>>;
 
-/// A measurement model \f$ z = h(x) + v,\; v \sim N(0, R) \f$.
+namespace detail {
+/// `h.noise()` returns the measurement covariance (noise independent of the state).
+template <class H>
+concept HasConstantNoise = requires(const H& h) {
+  { h.noise() } -> ReturnsExactly<CovarianceOf<typename H::Measurement>>;
+};
+/// `h.noise(x)` returns the measurement covariance at state x.
+template <class H>
+concept HasStateNoise = requires(const H& h, const typename H::State& x) {
+  { h.noise(x) } -> ReturnsExactly<CovarianceOf<typename H::Measurement>>;
+};
+}  // namespace detail
+
+/// A measurement model \f$ z = h(x) + v,\; v \sim N(0, R) \f$, or
+/// \f$ v \sim N(0, R(x)) \f$ when the noise depends on the state (e.g. a range
+/// sensor whose error grows with distance): the model then provides
+/// `noise(const State&)` instead of (or besides) `noise()`.
 template <class H>
 concept MeasurementModel =
     requires { typename H::State; typename H::Measurement; } && State<typename H::State> &&
@@ -155,8 +172,28 @@ concept MeasurementModel =
     requires(const H& h, const typename H::State& x) {
       { h.predict(x) } -> ReturnsExactly<typename H::Measurement>;
       { h.jacobian(x) } -> ReturnsExactly<MeasurementJacobianOf<H>>;
-      { h.noise() } -> ReturnsExactly<CovarianceOf<typename H::Measurement>>;
-    };
+    } && (detail::HasConstantNoise<H> || detail::HasStateNoise<H>);
+
+/// True when a measurement model's noise depends on the state, i.e. it has
+/// `noise(const State&)`. Estimators then call `noise(x)` at the prior state.
+template <MeasurementModel H>
+inline constexpr bool has_state_dependent_noise_v = detail::HasStateNoise<H>;
+
+/// The measurement noise \f$ R \f$ (or \f$ R(x) \f$) of a model at state x:
+/// `h.noise(x)` when the model has it, else `h.noise()`.
+/// @param[in] h a measurement model
+/// @param[in] x the state at which the measurement is predicted
+/// @return the covariance of the measurement (Measurement::Dim square)
+template <MeasurementModel H>
+[[nodiscard]] CovarianceOf<typename H::Measurement> measurement_noise(
+    const H& h, const typename H::State& x) {
+  if constexpr (detail::HasStateNoise<H>) {
+    return h.noise(x);
+  } else {
+    (void)x;
+    return h.noise();
+  }
+}
 
 /// A measurement model of the state type S.
 template <class H, class S>
@@ -177,10 +214,15 @@ inline constexpr bool has_identity_jacobian_v = [] {
 /// Measurement models whose Jacobian and noise depend neither on the state
 /// nor on time may say so with `static constexpr bool kTimeInvariant = true;`.
 /// The covariance part of their update is then a function of P alone, and
-/// estimators may reuse it while P repeats (a converged filter).
+/// estimators may reuse it while P repeats (a converged filter). A model with
+/// state-dependent noise (`noise(const State&)`) is never treated as
+/// time-invariant, whatever its flag says.
 template <class H>
 inline constexpr bool is_time_invariant_v = [] {
   if constexpr (requires { H::kTimeInvariant; }) {
+    if constexpr (requires { typename H::State; typename H::Measurement; }) {
+      if constexpr (detail::HasStateNoise<H>) return false;
+    }
     return bool(H::kTimeInvariant);
   } else {
     return false;
@@ -254,11 +296,10 @@ consteval bool check_measurement_model() {
                     },
                     "posefuse: a measurement model needs `Matrix<Scalar, Measurement::Dim, "
                     "State::Dim> jacobian(const State&) const` (J_h_x)");
-      static_assert(requires(const H& h) {
-                      { h.noise() } -> ReturnsExactly<CovarianceOf<Z>>;
-                    },
+      static_assert(detail::HasConstantNoise<H> || detail::HasStateNoise<H>,
                     "posefuse: a measurement model needs `Matrix<Scalar, Measurement::Dim, "
-                    "Measurement::Dim> noise() const`");
+                    "Measurement::Dim> noise() const` or, for noise that depends on the state, "
+                    "`noise(const State&) const`");
     }
   }
   return MeasurementModel<H>;

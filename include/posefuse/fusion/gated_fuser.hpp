@@ -5,29 +5,42 @@
 /// with Mahalanobis tests, averages angles on the circle, and **re-anchors**
 /// SLAM when it re-initialises in a new map frame instead of discarding it.
 ///
+/// Every step is a step of the library's one estimation core, an
+/// Ekf (filters/ekf.hpp) over PlanarPose with three models:
+///
 /// **State.** \f$x = [x, y, \theta]\f$ of the body in the world (=
-/// odometry) frame with a 3x3 covariance P, and \f$T_{wm}\f$, the pose of the
-/// current SLAM map frame in the world, estimated once per map (below).
+/// odometry) frame with a 3x3 covariance P (the Ekf's belief), and
+/// \f$T_{wm}\f$, the pose of the current SLAM map frame in the world,
+/// estimated once per map (below).
 ///
-/// **Odometry (prediction).** Only increments are used:
-/// \f$\delta = O_{k-1}^{-1} \oplus O_k\f$, \f$x \leftarrow x \oplus \delta\f$,
-/// \f$P \leftarrow J_x P J_x^T + J_\delta Q_\delta J_\delta^T\f$ with body-frame
-/// noise \f$Q_\delta = \mathrm{diag}(k_{xy}^2 s, k_{xy}^2 s, k_{\theta s}^2 s +
-/// k_{\theta\theta}^2 |\Delta\theta|)\f$ (s = distance). The fused pose is
-/// therefore odometry *rebased onto the fused estimate* after every update —
-/// the same as resetting dead reckoning to it — so odometry drift does not
-/// keep accumulating into it.
+/// **Odometry (prediction)**, Se2Odometry (models/se2_odometry.hpp). Only
+/// increments are used: \f$\delta = O_{k-1}^{-1} \oplus O_k\f$,
+/// \f$x \leftarrow x \oplus \delta\f$, \f$P \leftarrow F P F^T + J_\delta
+/// Q_\delta J_\delta^T\f$ with body-frame noise \f$Q_\delta =
+/// \mathrm{diag}(k_{xy}^2 s, k_{xy}^2 s, k_{\theta s}^2 s + k_{\theta\theta}^2
+/// |\Delta\theta|)\f$ (s = distance). The fused pose is therefore odometry
+/// *rebased onto the fused estimate* after every update — the same as
+/// resetting dead reckoning to it — so odometry drift does not keep
+/// accumulating into it.
 ///
-/// **SLAM (update).** The SLAM pose is transformed into the world,
-/// \f$z_w = T_{wm} \oplus z\f$, and fused by information weighting
-/// (fuse_poses: \f$K = P(P+R)^{-1}\f$, \f$x \leftarrow x \boxplus K(z_w \boxminus
-/// x)\f$, Joseph form), the heading residual wrapped — angle-aware averaging.
+/// **SLAM (update)**, PlanarPoseFix (models/planar_pose_fix.hpp). The SLAM
+/// pose is transformed into the world, \f$z_w = T_{wm} \oplus z\f$, and fused
+/// as a direct pose measurement, \f$H = I\f$, \f$S = P + R\f$,
+/// \f$K = P S^{-1}\f$, \f$x \leftarrow x \boxplus K(z_w \boxminus x)\f$,
+/// Joseph form — the heading residual wrapped: angle-aware averaging.
 ///
-/// **Gates** on \f$r = z_w \boxminus x\f$, \f$S = P + R\f$. kSeparate: position
+/// **Gates** on \f$r = z_w \boxminus x\f$, \f$S = P + R\f$, passed to the
+/// Ekf update as a gate functor. kSeparate: position
 /// \f$r_{xy}^T S_{xy}^{-1} r_{xy} \le \chi^2_2\f$ *and* heading
 /// \f$r_\theta^2 / S_{\theta\theta} \le \chi^2_1\f$ — a large position
 /// disagreement is rejected even when the headings agree, unlike seed eq 14.
-/// kMahalanobis: \f$r^T S^{-1} r \le \chi^2_3\f$. kBoth: all three.
+/// kMahalanobis: \f$r^T S^{-1} r \le \chi^2_3\f$. kBoth: all three. A
+/// rejection is FilterStatus::kGated with FuserStatus::rejected_by naming the
+/// gate (the first that failed, in the order position, heading, joint).
+///
+/// **Heading (update)**, HeadingFix (models/heading_fix.hpp), e.g. a compass
+/// aligned to the world: \f$r = \mathrm{wrap}(\psi - \theta)\f$, NIS gate
+/// \f$r^2 / S \le\f$ gate_theta_chi2.
 ///
 /// **Re-anchoring.** At the first SLAM pose and at every `new_map_frame`
 /// (seed: ORB-SLAM re-initialised), the fuser pairs the following SLAM poses
@@ -53,26 +66,34 @@
 #include <cmath>
 #include <concepts>
 #include <limits>
+#include <optional>
 
 #include <posefuse/core/angles.hpp>
 #include <posefuse/core/error.hpp>
 #include <posefuse/core/pipeline.hpp>
+#include <posefuse/core/status.hpp>
+#include <posefuse/filters/ekf.hpp>
+#include <posefuse/lie/se2.hpp>
+#include <posefuse/lie/so2.hpp>
+#include <posefuse/models/heading_fix.hpp>
 #include <posefuse/models/planar_pose.hpp>
+#include <posefuse/models/planar_pose_fix.hpp>
+#include <posefuse/models/se2_odometry.hpp>
 
 namespace posefuse {
 
 /// SE(2) composition \f$a \oplus b\f$ (b expressed in a's frame).
+/// Deprecated: use `SE2` (lie/se2.hpp), `as_se2(a) * as_se2(b)`.
 template <std::floating_point T>
 [[nodiscard]] inline PlanarPose<T> se2_compose(const PlanarPose<T>& a, const PlanarPose<T>& b) {
-  const T c = std::cos(a.theta), s = std::sin(a.theta);
-  return {a.x + c * b.x - s * b.y, a.y + s * b.x + c * b.y, wrap_angle(a.theta + b.theta)};
+  return as_planar_pose(as_se2(a) * as_se2(b));
 }
 
 /// SE(2) inverse \f$a^{-1}\f$.
+/// Deprecated: use `SE2` (lie/se2.hpp), `as_se2(a).inverse()`.
 template <std::floating_point T>
 [[nodiscard]] inline PlanarPose<T> se2_inverse(const PlanarPose<T>& a) {
-  const T c = std::cos(a.theta), s = std::sin(a.theta);
-  return {-c * a.x - s * a.y, s * a.x - c * a.y, wrap_angle(-a.theta)};
+  return as_planar_pose(as_se2(a).inverse());
 }
 
 /// A planar pose with its covariance (x, y, theta; m², m·rad, rad²).
@@ -83,49 +104,124 @@ struct PlanarPoseWithCov {
 };
 
 /// Information-weighted fusion of two estimates of one planar pose, angle-aware:
+/// one Ekf update of the belief (a, Pa) with b as a PlanarPoseFix of noise Pb,
 /// \f$ K = P_a (P_a + P_b)^{-1},\; x = a \boxplus K (b \boxminus a),\;
 /// P = (I-K) P_a (I-K)^\top + K P_b K^\top = (P_a^{-1} + P_b^{-1})^{-1} \f$,
 /// with the heading residual wrapped, so 179° and -179° with equal weights
 /// fuse to 180°, not 0° (cf. seed eq 15-a).
 /// @param[in] a, Pa first estimate and its covariance
 /// @param[in] b, Pb second estimate and its covariance
-/// @return the fused pose and covariance; NaN when Pa + Pb is not positive definite
+/// @return the fused pose and covariance; NaN when Pa + Pb is not positive
+///         definite or b is not finite
+/// @throws posefuse::invalid_argument if a is not finite, or Pa or Pb is not a
+///         finite symmetric positive semi-definite covariance
 template <std::floating_point T>
 [[nodiscard]] inline PlanarPoseWithCov<T> fuse_poses(const PlanarPose<T>& a,
                                                      const Eigen::Matrix<T, 3, 3>& Pa,
                                                      const PlanarPose<T>& b,
                                                      const Eigen::Matrix<T, 3, 3>& Pb) {
-  using Mat3 = Eigen::Matrix<T, 3, 3>;
-  const Eigen::LDLT<Mat3> ldlt(Pa + Pb);
-  if (ldlt.info() != Eigen::Success || !ldlt.isPositive() || !(ldlt.vectorD().array() > 0).all())
-    return {{std::numeric_limits<T>::quiet_NaN(), std::numeric_limits<T>::quiet_NaN(),
-             std::numeric_limits<T>::quiet_NaN()},
-            Mat3::Constant(std::numeric_limits<T>::quiet_NaN())};
-  const Mat3 K = ldlt.solve(Pa).transpose();  // Pa (Pa + Pb)^-1
-  const Mat3 IK = Mat3::Identity() - K;
-  return {a.plus(K * b.minus(a)), IK * Pa * IK.transpose() + K * Pb * K.transpose()};
+  Ekf<Se2Odometry<T>> ekf{Se2Odometry<T>{}};  // the motion model is not used
+  ekf.reset(a, Pa);
+  if (!ekf.update_with(PlanarPoseFix<T>(Pb), b)) {
+    constexpr T nan = std::numeric_limits<T>::quiet_NaN();
+    return {{nan, nan, nan}, Eigen::Matrix<T, 3, 3>::Constant(nan)};
+  }
+  return {ekf.state(), ekf.covariance()};
 }
 
 /// How GatedFuser tests a SLAM pose against its prediction.
 enum class GateMode { kSeparate, kMahalanobis, kBoth };
 
-/// What happened to one sample given to GatedFuser.
-enum class FuserStatus {
-  kPredicted,          ///< odometry increment applied
-  kFused,              ///< measurement passed the gates and was fused
-  kRejectedPosition,   ///< position gate failed
-  kRejectedHeading,    ///< heading gate failed
-  kRejectedJoint,      ///< 3-dof Mahalanobis gate failed
-  kAnchoring,          ///< collecting SLAM poses to estimate the map frame
-  kAnchored,           ///< map frame estimated from the collected poses
-  kNonFinite,          ///< NaN/Inf input; state untouched
-  kSingularInnovation  ///< innovation covariance not positive definite; state untouched
+/// What a SLAM pose given to GatedFuser did about the map-frame anchor.
+enum class AnchorEvent {
+  kNone,        ///< nothing: the map frame was anchored already (or not a SLAM pose)
+  kCollecting,  ///< kept to estimate a (new) map frame; not fused
+  kAnchored,    ///< completed the estimate of the map frame; not fused itself
 };
 
-/// True for the rejected-by-gate statuses.
-[[nodiscard]] constexpr bool is_rejection(FuserStatus s) noexcept {
-  return s == FuserStatus::kRejectedPosition || s == FuserStatus::kRejectedHeading ||
-         s == FuserStatus::kRejectedJoint;
+/// Which of GatedFuser's gates rejected a measurement.
+enum class FuserGate {
+  kNone,      ///< none (not rejected)
+  kPosition,  ///< the 2-dof position gate
+  kHeading,   ///< the 1-dof heading gate (SLAM heading or update_heading)
+  kJoint,     ///< the 3-dof Mahalanobis gate
+};
+
+/// Human-readable name of an anchor event.
+[[nodiscard]] constexpr const char* to_string(AnchorEvent e) noexcept {
+  switch (e) {
+    case AnchorEvent::kNone: return "none";
+    case AnchorEvent::kCollecting: return "collecting anchor poses";
+    case AnchorEvent::kAnchored: return "anchored";
+  }
+  return "unknown";
+}
+
+/// Human-readable name of a gate.
+[[nodiscard]] constexpr const char* to_string(FuserGate g) noexcept {
+  switch (g) {
+    case FuserGate::kNone: return "none";
+    case FuserGate::kPosition: return "position gate";
+    case FuserGate::kHeading: return "heading gate";
+    case FuserGate::kJoint: return "joint Mahalanobis gate";
+  }
+  return "unknown";
+}
+
+/// What happened to one measurement given to GatedFuser: the Ekf step's
+/// FilterStatus, plus, for SLAM poses, the anchoring event and which gate
+/// rejected it. Converts implicitly from a FilterStatus (no anchoring event,
+/// no gate). The named constants are the common outcomes; compare with `==`.
+struct FuserStatus {
+  /// The filter step: kApplied (fused), kGated (see rejected_by), kNonFinite,
+  /// kInvalidInput, kNotPositiveDefinite; kNotInitialised when the pose went
+  /// to the anchor estimate instead (see anchor).
+  FilterStatus step = FilterStatus::kApplied;
+  AnchorEvent anchor = AnchorEvent::kNone;    ///< anchoring (SLAM poses)
+  FuserGate rejected_by = FuserGate::kNone;   ///< the gate that failed, when step == kGated
+
+  /// Applied, nothing else happened.
+  constexpr FuserStatus() noexcept = default;
+  /// A step outcome with its anchoring event and rejecting gate.
+  constexpr FuserStatus(FilterStatus s, AnchorEvent a = AnchorEvent::kNone,  // NOLINT: implicit
+                        FuserGate g = FuserGate::kNone) noexcept
+      : step(s), anchor(a), rejected_by(g) {}
+
+  /// True when the measurement changed the estimate.
+  [[nodiscard]] constexpr bool applied() const noexcept { return step == FilterStatus::kApplied; }
+  /// All fields equal.
+  friend constexpr bool operator==(const FuserStatus&, const FuserStatus&) noexcept = default;
+
+  static const FuserStatus kFused;              ///< {kApplied}: passed the gates and was fused
+  static const FuserStatus kRejectedPosition;   ///< {kGated, -, kPosition}
+  static const FuserStatus kRejectedHeading;    ///< {kGated, -, kHeading}
+  static const FuserStatus kRejectedJoint;      ///< {kGated, -, kJoint}
+  static const FuserStatus kAnchoring;          ///< {kNotInitialised, kCollecting}
+  static const FuserStatus kAnchored;           ///< {kNotInitialised, kAnchored}
+  static const FuserStatus kNonFinite;          ///< {kNonFinite}: NaN/Inf input; state untouched
+  static const FuserStatus kSingularInnovation; ///< {kNotPositiveDefinite}; state untouched
+  /// {kApplied}, the same value as kFused: kept for code written when
+  /// predict() returned a FuserStatus (it now returns the FilterStatus).
+  static const FuserStatus kPredicted;
+};
+inline constexpr FuserStatus FuserStatus::kFused{FilterStatus::kApplied};
+inline constexpr FuserStatus FuserStatus::kRejectedPosition{FilterStatus::kGated, AnchorEvent::kNone,
+                                                            FuserGate::kPosition};
+inline constexpr FuserStatus FuserStatus::kRejectedHeading{FilterStatus::kGated, AnchorEvent::kNone,
+                                                           FuserGate::kHeading};
+inline constexpr FuserStatus FuserStatus::kRejectedJoint{FilterStatus::kGated, AnchorEvent::kNone,
+                                                         FuserGate::kJoint};
+inline constexpr FuserStatus FuserStatus::kAnchoring{FilterStatus::kNotInitialised,
+                                                     AnchorEvent::kCollecting};
+inline constexpr FuserStatus FuserStatus::kAnchored{FilterStatus::kNotInitialised,
+                                                    AnchorEvent::kAnchored};
+inline constexpr FuserStatus FuserStatus::kNonFinite{FilterStatus::kNonFinite};
+inline constexpr FuserStatus FuserStatus::kSingularInnovation{FilterStatus::kNotPositiveDefinite};
+inline constexpr FuserStatus FuserStatus::kPredicted{FilterStatus::kApplied};
+
+/// True when a gate rejected the measurement.
+[[nodiscard]] constexpr bool is_rejection(const FuserStatus& s) noexcept {
+  return s.step == FilterStatus::kGated;
 }
 
 /// Parameters of GatedFuser. Sigmas are 1-σ; gates are χ² quantiles.
@@ -161,11 +257,15 @@ template <std::floating_point T = double>
 struct GatedFuserOutput {
   PlanarPose<T> pose;                         ///< fused pose in the world frame
   Eigen::Matrix<T, 3, 3> cov;                 ///< its covariance
-  FuserStatus slam_status = FuserStatus::kPredicted;  ///< what happened to the SLAM pose
+  FilterStatus odom_status = FilterStatus::kApplied;  ///< what the prediction did
+  /// What happened to the SLAM pose; empty when the input had none or the
+  /// prediction was not applied (the SLAM pose is then not used).
+  std::optional<FuserStatus> slam_status;
 };
 
 /// Covariance-weighted, gated, re-anchoring fusion of odometry and SLAM on
-/// the plane (see the file comment for the equations). Fixed-size, no heap.
+/// the plane (see the file comment for the equations), built on
+/// Ekf<Se2Odometry<T>>. Fixed-size, no heap.
 template <std::floating_point T = double>
 class GatedFuser {
  public:
@@ -175,12 +275,144 @@ class GatedFuser {
   using Mat3 = Eigen::Matrix<T, 3, 3>;
   using Input = GatedFuserInput<T>;
   using Output = GatedFuserOutput<T>;
+  using Filter = Ekf<Se2Odometry<T>>;  ///< the estimation core
   static constexpr int kMaxAnchorSamples = 32;
 
   /// @throws posefuse::invalid_argument for a negative or non-finite sigma, a
   ///         non-positive gate or tolerance, or anchor_samples /
   ///         reanchor_after_rejects out of range
-  explicit GatedFuser(const GatedFuserParams<T>& p = {}) : p_(p) {
+  explicit GatedFuser(const GatedFuserParams<T>& p = {})
+      : p_(validated(p)),
+        ekf_(Se2Odometry<T>(Se2OdometryNoise<T>{p.odom_xy_sigma_per_sqrt_m,
+                                                p.odom_theta_sigma_per_sqrt_m,
+                                                p.odom_theta_sigma_per_sqrt_rad})),
+        slam_(PlanarPoseFix<T>::from_sigmas(p.slam_xy_sigma_m, p.slam_theta_sigma_rad)) {
+    reset(Pose{}, Mat3::Identity() * T(1e-6));
+  }
+
+  /// Restarts at `start` (world frame) with covariance `cov`; forgets the
+  /// odometry reference, any SLAM anchor, the distance travelled and the
+  /// anchor count.
+  /// @throws posefuse::invalid_argument if start is not finite or cov is not a
+  ///         finite symmetric PSD matrix (the fuser is then unchanged)
+  void reset(const Pose& start, const Mat3& cov) {
+    ekf_.reset(start, cov);
+    a_ = Pose{};
+    Pa_.setZero();
+    have_odom_ = false;
+    anchor_ = AnchorState::kNone;
+    n_cand_ = 0;
+    rejects_ = 0;
+    travelled_ = 0;
+    anchors_ = 0;
+  }
+
+  /// Applies the odometry increment since the previous call (the first call
+  /// only stores the reference) as an Ekf prediction with Se2Odometry.
+  /// @param[in] odom odometry pose in the odometry frame (m, rad)
+  /// @return kApplied, or kNonFinite (state untouched)
+  [[nodiscard]] FilterStatus predict(const Pose& odom) noexcept {
+    if (!std::isfinite(odom.x) || !std::isfinite(odom.y) || !std::isfinite(odom.theta))
+      return FilterStatus::kNonFinite;
+    if (!have_odom_) {
+      odom_ = odom;
+      have_odom_ = true;
+      return FilterStatus::kApplied;
+    }
+    const SE2<T> d = as_se2(odom_).between(as_se2(odom));  // δ = O_{k-1}^-1 O_k
+    const FilterStatus s = ekf_.predict(d, T(0));
+    if (s != FilterStatus::kApplied) return s;
+    odom_ = odom;
+    travelled_ += std::hypot(d.x(), d.y());
+    return s;
+  }
+
+  /// Fuses a SLAM pose taken at the time of the last predict().
+  /// @param[in] z             body pose in the SLAM map frame (m, rad)
+  /// @param[in] new_map_frame true when SLAM re-initialised (z is the first
+  ///                          pose of a new map frame)
+  /// @return kFused; a rejection (step kGated, rejected_by the gate);
+  ///         kAnchoring / kAnchored (step kNotInitialised: the pose went to the
+  ///         anchor estimate); kNonFinite or kSingularInnovation
+  [[nodiscard]] FuserStatus update_slam(const Pose& z, bool new_map_frame) noexcept {
+    if (!std::isfinite(z.x) || !std::isfinite(z.y) || !std::isfinite(z.theta))
+      return FuserStatus::kNonFinite;
+    if (new_map_frame || anchor_ == AnchorState::kNone) start_anchoring();
+    if (anchor_ == AnchorState::kCollecting) return collect(z);
+    const Pose zw = as_planar_pose(as_se2(a_) * as_se2(z));  // SLAM pose in the world
+    FuserGate failed = FuserGate::kNone;
+    const auto gates = [this, &failed](const Vec3& r, const Mat3& S, T nis) {
+      failed = which_gate_fails(r, S, nis);
+      return failed == FuserGate::kNone;
+    };
+    // R is isotropic in x, y: the same in the map and the world frame.
+    const auto res = ekf_.update_with(slam_, zw, gates);
+    if (res.status == FilterStatus::kGated) {
+      if (++rejects_ >= p_.reanchor_after_rejects) start_anchoring();
+      return {FilterStatus::kGated, AnchorEvent::kNone, failed};
+    }
+    if (res.status == FilterStatus::kApplied) rejects_ = 0;
+    return res.status;
+  }
+
+  /// Fuses an absolute heading (e.g. a compass aligned to the world frame)
+  /// as an Ekf update with HeadingFix, gated by \f$r^2/S \le\f$ gate_theta_chi2.
+  /// @param[in] yaw   heading in the world frame (rad)
+  /// @param[in] sigma its 1-σ noise (rad, > 0)
+  /// @return kFused, kRejectedHeading, kNonFinite (yaw or sigma not finite),
+  ///         {kInvalidInput} (sigma <= 0) or kSingularInnovation
+  [[nodiscard]] FuserStatus update_heading(T yaw, T sigma) noexcept {
+    if (!std::isfinite(yaw) || !std::isfinite(sigma)) return FuserStatus::kNonFinite;
+    if (!(sigma > T(0))) return FilterStatus::kInvalidInput;
+    const auto res = ekf_.update_with(HeadingFix<T>(sigma), SO2<T>(yaw), p_.gate_theta_chi2);
+    if (res.status == FilterStatus::kGated) return FuserStatus::kRejectedHeading;
+    return res.status;
+  }
+
+  /// Stage form: predict with `in.odom`, then fuse `in.slam` if present.
+  [[nodiscard]] Output operator()(const Input& in) noexcept {
+    Output out;
+    out.odom_status = predict(in.odom);
+    if (in.has_slam && out.odom_status == FilterStatus::kApplied)
+      out.slam_status = update_slam(in.slam, in.slam_new_map_frame);
+    out.pose = pose();
+    out.cov = covariance();
+    return out;
+  }
+
+  /// Fused body pose in the world frame.
+  [[nodiscard]] const Pose& pose() const noexcept { return ekf_.state(); }
+  /// Its covariance, relative to the anchored SLAM map once one is anchored.
+  [[nodiscard]] const Mat3& covariance() const noexcept { return ekf_.covariance(); }
+  /// Covariance of the pose when the current map was anchored (the part of
+  /// the error that SLAM cannot remove); zero before the first anchor.
+  [[nodiscard]] const Mat3& anchor_covariance() const noexcept { return Pa_; }
+  /// True when a SLAM map frame is anchored (SLAM poses are being fused).
+  [[nodiscard]] bool anchored() const noexcept { return anchor_ == AnchorState::kAnchored; }
+  /// \f$T_{wm}\f$: the current SLAM map frame in the world (valid when anchored()).
+  [[nodiscard]] const Pose& map_in_world() const noexcept { return a_; }
+  /// \f$T_{wo} = x \oplus O_k^{-1}\f$: maps the odometry frame onto the fused
+  /// estimate (rebasing); `as_se2(odometry_correction()) * as_se2(odom)` is
+  /// the fused pose at the last predict().
+  [[nodiscard]] Pose odometry_correction() const noexcept {
+    return as_planar_pose(as_se2(pose()) * as_se2(odom_).inverse());
+  }
+  /// Odometry distance travelled since construction or reset() (m).
+  [[nodiscard]] T travelled() const noexcept { return travelled_; }
+  /// Number of anchors estimated so far (first frame, re-inits, unannounced changes).
+  [[nodiscard]] int anchor_count() const noexcept { return anchors_; }
+  /// The underlying filter (read-only).
+  [[nodiscard]] const Filter& filter() const noexcept { return ekf_; }
+
+ private:
+  enum class AnchorState { kNone, kCollecting, kAnchored };
+  struct Candidate {
+    Pose x;  // fused (odometry-propagated) pose when the SLAM pose arrived
+    Pose z;  // the SLAM pose, map frame
+    T s;     // odometry distance travelled by then (m)
+  };
+
+  static const GatedFuserParams<T>& validated(const GatedFuserParams<T>& p) {
     const T s[] = {p.odom_xy_sigma_per_sqrt_m, p.odom_theta_sigma_per_sqrt_m,
                    p.odom_theta_sigma_per_sqrt_rad, p.anchor_min_travel_m};
     for (T v : s)
@@ -195,143 +427,8 @@ class GatedFuser {
       throw invalid_argument("GatedFuser: anchor_samples must lie in [1, 32]");
     if (p.reanchor_after_rejects < 1)
       throw invalid_argument("GatedFuser: reanchor_after_rejects must be >= 1");
-    const T sxy = p.slam_xy_sigma_m, sth = p.slam_theta_sigma_rad;
-    R_ = Vec3(sxy * sxy, sxy * sxy, sth * sth).asDiagonal();
-    reset(Pose{}, Mat3::Identity() * T(1e-6));
+    return p;
   }
-
-  /// Restarts at `start` (world frame) with covariance `cov`; forgets the
-  /// odometry reference, any SLAM anchor, the distance travelled and the
-  /// anchor count.
-  void reset(const Pose& start, const Mat3& cov) noexcept {
-    x_ = start;
-    a_ = Pose{};
-    P_ = cov;
-    Pa_.setZero();
-    have_odom_ = false;
-    anchor_ = AnchorState::kNone;
-    n_cand_ = 0;
-    rejects_ = 0;
-    travelled_ = 0;
-    anchors_ = 0;
-  }
-
-  /// Applies the odometry increment since the previous call (the first call
-  /// only stores the reference).
-  /// @param[in] odom odometry pose in the odometry frame (m, rad)
-  /// @return kPredicted, or kNonFinite (state untouched)
-  [[nodiscard]] FuserStatus predict(const Pose& odom) noexcept {
-    if (!std::isfinite(odom.x) || !std::isfinite(odom.y) || !std::isfinite(odom.theta))
-      return FuserStatus::kNonFinite;
-    if (!have_odom_) {
-      odom_ = odom;
-      have_odom_ = true;
-      return FuserStatus::kPredicted;
-    }
-    const Pose d = se2_compose(se2_inverse(odom_), odom);
-    odom_ = odom;
-    const T ds = std::hypot(d.x, d.y), dth = std::abs(d.theta);
-    const T c = std::cos(x_.theta), s = std::sin(x_.theta);
-    Mat3 Jx = Mat3::Identity();
-    Jx(0, 2) = -s * d.x - c * d.y;
-    Jx(1, 2) = c * d.x - s * d.y;
-    Mat3 Jd = Mat3::Identity();
-    Jd.template topLeftCorner<2, 2>() << c, -s, s, c;
-    const T kxy = p_.odom_xy_sigma_per_sqrt_m, kts = p_.odom_theta_sigma_per_sqrt_m,
-            ktt = p_.odom_theta_sigma_per_sqrt_rad;
-    const Vec3 q(kxy * kxy * ds, kxy * kxy * ds, kts * kts * ds + ktt * ktt * dth);
-    x_ = se2_compose(x_, d);
-    travelled_ += ds;
-    P_ = Jx * P_ * Jx.transpose() + Jd * q.asDiagonal() * Jd.transpose();
-    return FuserStatus::kPredicted;
-  }
-
-  /// Fuses a SLAM pose taken at the time of the last predict().
-  /// @param[in] z             body pose in the SLAM map frame (m, rad)
-  /// @param[in] new_map_frame true when SLAM re-initialised (z is the first
-  ///                          pose of a new map frame)
-  /// @return kFused, a rejection, kAnchoring / kAnchored, kNonFinite or
-  ///         kSingularInnovation
-  [[nodiscard]] FuserStatus update_slam(const Pose& z, bool new_map_frame) noexcept {
-    if (!std::isfinite(z.x) || !std::isfinite(z.y) || !std::isfinite(z.theta))
-      return FuserStatus::kNonFinite;
-    if (new_map_frame || anchor_ == AnchorState::kNone) start_anchoring();
-    if (anchor_ == AnchorState::kCollecting) return collect(z);
-    const Pose zw = se2_compose(a_, z);  // SLAM pose in the world
-    const Vec3 r = zw.minus(x_);
-    const Mat3 S = P_ + R_;  // R is isotropic in x, y: the same in any frame
-    const Eigen::LDLT<Mat3> ldlt(S);
-    if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return FuserStatus::kSingularInnovation;
-    const FuserStatus g = gate(r, S, ldlt);
-    if (g != FuserStatus::kFused) {
-      if (++rejects_ >= p_.reanchor_after_rejects) start_anchoring();
-      return g;
-    }
-    rejects_ = 0;
-    const Mat3 K = ldlt.solve(P_).transpose();  // P (P + R)^-1
-    const Mat3 IK = Mat3::Identity() - K;
-    x_ = x_.plus(K * r);
-    P_ = IK * P_ * IK.transpose() + K * R_ * K.transpose();
-    return FuserStatus::kFused;
-  }
-
-  /// Fuses an absolute heading (e.g. a compass aligned to the world frame),
-  /// gated by \f$r^2/S \le\f$ gate_theta_chi2.
-  /// @param[in] yaw   heading in the world frame (rad)
-  /// @param[in] sigma its 1-σ noise (rad, > 0)
-  [[nodiscard]] FuserStatus update_heading(T yaw, T sigma) noexcept {
-    if (!std::isfinite(yaw) || !std::isfinite(sigma) || !(sigma > 0)) return FuserStatus::kNonFinite;
-    const T r = angle_diff(yaw, x_.theta), S = P_(2, 2) + sigma * sigma;
-    if (!(S > 0)) return FuserStatus::kSingularInnovation;
-    if (r * r > p_.gate_theta_chi2 * S) return FuserStatus::kRejectedHeading;
-    const Vec3 K = P_.col(2) / S;
-    Mat3 IKH = Mat3::Identity();
-    IKH.col(2) -= K;
-    x_ = x_.plus(K * r);
-    P_ = IKH * P_ * IKH.transpose() + (sigma * sigma) * K * K.transpose();
-    return FuserStatus::kFused;
-  }
-
-  /// Stage form: predict with `in.odom`, then fuse `in.slam` if present.
-  [[nodiscard]] Output operator()(const Input& in) noexcept {
-    Output out;
-    out.slam_status = predict(in.odom);
-    if (in.has_slam && out.slam_status == FuserStatus::kPredicted)
-      out.slam_status = update_slam(in.slam, in.slam_new_map_frame);
-    out.pose = x_;
-    out.cov = P_;
-    return out;
-  }
-
-  /// Fused body pose in the world frame.
-  [[nodiscard]] const Pose& pose() const noexcept { return x_; }
-  /// Its covariance, relative to the anchored SLAM map once one is anchored.
-  [[nodiscard]] const Mat3& covariance() const noexcept { return P_; }
-  /// Covariance of the pose when the current map was anchored (the part of
-  /// the error that SLAM cannot remove); zero before the first anchor.
-  [[nodiscard]] const Mat3& anchor_covariance() const noexcept { return Pa_; }
-  /// True when a SLAM map frame is anchored (SLAM poses are being fused).
-  [[nodiscard]] bool anchored() const noexcept { return anchor_ == AnchorState::kAnchored; }
-  /// \f$T_{wm}\f$: the current SLAM map frame in the world (valid when anchored()).
-  [[nodiscard]] const Pose& map_in_world() const noexcept { return a_; }
-  /// \f$T_{wo} = x \oplus O_k^{-1}\f$: maps the odometry frame onto the fused
-  /// estimate (rebasing); `se2_compose(odometry_correction(), odom)` is the
-  /// fused pose at the last predict().
-  [[nodiscard]] Pose odometry_correction() const noexcept {
-    return se2_compose(x_, se2_inverse(odom_));
-  }
-  /// Odometry distance travelled since construction or reset() (m).
-  [[nodiscard]] T travelled() const noexcept { return travelled_; }
-  /// Number of anchors estimated so far (first frame, re-inits, unannounced changes).
-  [[nodiscard]] int anchor_count() const noexcept { return anchors_; }
-
- private:
-  enum class AnchorState { kNone, kCollecting, kAnchored };
-  struct Candidate {
-    Pose x;  // fused (odometry-propagated) pose when the SLAM pose arrived
-    Pose z;  // the SLAM pose, map frame
-    T s;     // odometry distance travelled by then (m)
-  };
 
   void start_anchoring() noexcept {
     anchor_ = AnchorState::kCollecting;
@@ -339,16 +436,16 @@ class GatedFuser {
     rejects_ = 0;
   }
 
-  FuserStatus gate(const Vec3& r, const Mat3& S, const Eigen::LDLT<Mat3>& ldlt) const noexcept {
+  /// The first of the configured gates that r fails (kNone: accepted).
+  FuserGate which_gate_fails(const Vec3& r, const Mat3& S, T nis) const noexcept {
     if (p_.gate != GateMode::kMahalanobis) {
       const Eigen::Matrix<T, 2, 1> rxy = r.template head<2>();
       const T dxy = rxy.dot(S.template topLeftCorner<2, 2>().ldlt().solve(rxy));
-      if (!(dxy <= p_.gate_xy_chi2)) return FuserStatus::kRejectedPosition;
-      if (!(r(2) * r(2) <= p_.gate_theta_chi2 * S(2, 2))) return FuserStatus::kRejectedHeading;
+      if (!(dxy <= p_.gate_xy_chi2)) return FuserGate::kPosition;
+      if (!(r(2) * r(2) <= p_.gate_theta_chi2 * S(2, 2))) return FuserGate::kHeading;
     }
-    if (p_.gate != GateMode::kSeparate && !(r.dot(ldlt.solve(r)) <= p_.gate_joint_chi2))
-      return FuserStatus::kRejectedJoint;
-    return FuserStatus::kFused;
+    if (p_.gate != GateMode::kSeparate && !(nis <= p_.gate_joint_chi2)) return FuserGate::kJoint;
+    return FuserGate::kNone;
   }
 
   FuserStatus collect(const Pose& z) noexcept {
@@ -356,7 +453,7 @@ class GatedFuser {
       for (int i = 1; i < n_cand_; ++i) cand_[std::size_t(i - 1)] = cand_[std::size_t(i)];
       --n_cand_;
     }
-    cand_[std::size_t(n_cand_++)] = {x_, z, travelled_};
+    cand_[std::size_t(n_cand_++)] = {pose(), z, travelled_};
     if (n_cand_ < p_.anchor_samples) return FuserStatus::kAnchoring;
     // The window: the newest anchor_samples pairs, widened until it spans
     // anchor_min_travel_m of odometry (unless the buffer is full).
@@ -373,32 +470,36 @@ class GatedFuser {
       ss += std::sin(c.x.theta - c.z.theta);
       sc += std::cos(c.x.theta - c.z.theta);
     }
-    const Pose rot{0, 0, std::atan2(ss, sc)};
-    Pose mean = rot;
+    const T yaw = std::atan2(ss, sc);
+    const SO2<T> rot(yaw);
+    Pose mean{0, 0, wrap_angle(yaw)};
     for (int i = first; i < n_cand_; ++i) {
       const Candidate& c = cand_[std::size_t(i)];
-      const Pose r = se2_compose(rot, c.z);
-      mean.x += (c.x.x - r.x) / T(N);
-      mean.y += (c.x.y - r.y) / T(N);
+      const typename SO2<T>::Point r = rot.act(c.z.position());
+      mean.x += (c.x.x - r.x()) / T(N);
+      mean.y += (c.x.y - r.y()) / T(N);
     }
     // Consistency, checked at the robot (free of the lever arm to the map
     // origin): every pair must satisfy x_i ~ mean (+) z_i.
+    const SE2<T> T_wm = as_se2(mean);
     for (int i = first; i < n_cand_; ++i) {
       const Candidate& c = cand_[std::size_t(i)];
-      const Vec3 e = c.x.minus(se2_compose(mean, c.z));
+      const Vec3 e = c.x.minus(as_planar_pose(T_wm * as_se2(c.z)));
       if (std::hypot(e(0), e(1)) > p_.anchor_tol_xy_m || std::abs(e(2)) > p_.anchor_tol_theta_rad)
         return FuserStatus::kAnchoring;  // inconsistent (frozen, jumping): keep collecting
     }
     a_ = mean;
-    Pa_ = P_;
+    Pa_ = covariance();
     anchor_ = AnchorState::kAnchored;
     ++anchors_;
     return FuserStatus::kAnchored;
   }
 
   GatedFuserParams<T> p_;
-  Pose x_{}, a_{}, odom_{};
-  Mat3 P_ = Mat3::Identity(), Pa_ = Mat3::Zero(), R_ = Mat3::Identity();
+  Filter ekf_;
+  PlanarPoseFix<T> slam_;
+  Pose a_{}, odom_{};
+  Mat3 Pa_ = Mat3::Zero();
   bool have_odom_ = false;
   AnchorState anchor_ = AnchorState::kNone;
   std::array<Candidate, kMaxAnchorSamples> cand_{};

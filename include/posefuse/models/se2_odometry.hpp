@@ -1,0 +1,134 @@
+#pragma once
+/// @file
+/// Odometry increments on the plane as a motion model: the state is a
+/// PlanarPose (\f$ \mathbb{R}^2 \times S^1 \f$, world frame), the control the
+/// body-frame increment \f$ \delta = O_{k-1}^{-1} \oplus O_k \f$ between two
+/// odometry poses, as an SE(2) element.
+///
+/// **Prediction.** \f$ x' = x \oplus \delta \f$ (SE(2) composition:
+/// \f$ t' = t + R(\theta)\,t_\delta,\; \theta' = \theta + \theta_\delta \f$).
+///
+/// **Jacobian with respect to the state.** lie/se2.hpp gives right Jacobians,
+/// for perturbations \f$ x\,\mathrm{Exp}(\tau) \f$ in the body frame; the
+/// state's `plus` perturbs in the world frame, \f$ e = (\delta t_w,
+/// \delta\theta) \f$. To first order \f$ x\,\mathrm{Exp}(\tau) = (t + R\rho,
+/// \theta + \phi) \f$, i.e. \f$ e = M(\theta)\,\tau \f$ with \f$ M(\theta) =
+/// \mathrm{diag}(R(\theta), 1) \f$, so a right Jacobian \f$ J \f$ of a map
+/// between poses becomes \f$ M(\theta_{out})\,J\,M(\theta_{in})^\top \f$ on
+/// \f$ \mathbb{R}^2 \times S^1 \f$. For \f$ x \oplus \delta \f$ the position
+/// row block is that of the action \f$ t' = x \cdot t_\delta \f$, whose SE(2)
+/// Jacobian is \f$ J_{t',x} = [R,\; R [1]_\times t_\delta] \f$
+/// (`SE2::act`'s `J_q_g`); times \f$ M(\theta)^\top \f$ it is
+/// \f$ [I,\; R [1]_\times t_\delta] \f$, and the heading row is
+/// \f$ [0, 0, 1] \f$:
+/// \f[ F = \begin{bmatrix} I_2 & R(\theta)[1]_\times t_\delta \\ 0 & 1
+///     \end{bmatrix} \f]
+/// (the SE(2) Jacobians are Solà, Deray, Atchuthan, arXiv:1812.01537, App. C;
+/// the change of perturbation is derived here).
+///
+/// **Noise.** Additive on the increment's components \f$ (t_{\delta,x},
+/// t_{\delta,y}, \theta_\delta) \f$ in the body frame,
+/// \f$ Q_\delta = \mathrm{diag}(k_{xy}^2 s,\; k_{xy}^2 s,\; k_{\theta s}^2 s +
+/// k_{\theta\theta}^2 |\theta_\delta|) \f$ with \f$ s = \|t_\delta\| \f$
+/// (random-walk growth with distance and with the angle turned), mapped to
+/// the state by \f$ J_\delta = \mathrm{diag}(R(\theta), 1) \f$ (`SE2::act`'s
+/// `J_q_p` and the angle sum): \f$ Q = J_\delta Q_\delta J_\delta^\top \f$.
+
+#include <Eigen/Core>
+#include <cmath>
+#include <concepts>
+#include <posefuse/core/concepts.hpp>
+#include <posefuse/core/error.hpp>
+#include <posefuse/lie/se2.hpp>
+#include <posefuse/models/planar_pose.hpp>
+
+namespace posefuse {
+
+/// The SE(2) element of a planar pose: body frame in the world, (x, y) m, θ rad.
+template <std::floating_point T>
+[[nodiscard]] inline SE2<T> as_se2(const PlanarPose<T>& p) noexcept {
+  return SE2<T>(p.x, p.y, p.theta);
+}
+
+/// The planar pose of an SE(2) element (θ in [-π, π)).
+template <std::floating_point T>
+[[nodiscard]] inline PlanarPose<T> as_planar_pose(const SE2<T>& g) noexcept {
+  return {g.x(), g.y(), g.angle()};
+}
+
+/// Noise of Se2Odometry: 1-σ growth per √distance and per √angle turned.
+template <std::floating_point T = double>
+struct Se2OdometryNoise {
+  T xy_sigma_per_sqrt_m = T(0.02);         ///< position noise per √m travelled (m/√m)
+  T theta_sigma_per_sqrt_m = T(0.005);     ///< heading noise per √m travelled (rad/√m)
+  T theta_sigma_per_sqrt_rad = T(0.03);    ///< heading noise per √rad turned (rad/√rad)
+};
+
+/// Motion model \f$ x' = x \oplus \delta \f$ on PlanarPose driven by odometry
+/// increments (see the file comment for F and Q).
+template <std::floating_point T = double>
+class Se2Odometry {
+ public:
+  using State = PlanarPose<T>;     ///< body pose in the world frame
+  using Control = SE2<T>;          ///< body-frame increment δ = O_{k-1}⁻¹ O_k
+  using Matrix3 = Eigen::Matrix<T, 3, 3>;
+  using Vector3 = Eigen::Matrix<T, 3, 1>;
+
+  /// @param[in] noise growth rates of the increment noise (all >= 0)
+  /// @throws posefuse::invalid_argument if a rate is negative or not finite
+  explicit Se2Odometry(const Se2OdometryNoise<T>& noise = {}) : n_(noise) {
+    for (T v : {n_.xy_sigma_per_sqrt_m, n_.theta_sigma_per_sqrt_m, n_.theta_sigma_per_sqrt_rad})
+      if (!std::isfinite(v) || v < T(0))
+        throw invalid_argument("Se2Odometry: noise rates must be finite and >= 0");
+  }
+
+  /// \f$ x \oplus \delta \f$ (the time step is not used: δ is the motion).
+  [[nodiscard]] State predict(const State& x, const Control& d, T /*dt_s*/) const noexcept {
+    return as_planar_pose(as_se2(x).compose(d));
+  }
+
+  /// \f$ F = \partial (x \oplus \delta) / \partial x \f$ on \f$ \mathbb{R}^2 \times S^1 \f$.
+  [[nodiscard]] Matrix3 jacobian(const State& x, const Control& d, T /*dt_s*/) const noexcept {
+    typename SE2<T>::ActJacobianGroup J_t_x;
+    (void)as_se2(x).act(d.translation(), &J_t_x);
+    // J_t_x * M(θ)^T: the left block R R^T is the identity exactly.
+    Matrix3 F = Matrix3::Identity();
+    F.template topRightCorner<2, 1>() = J_t_x.col(2);
+    return F;
+  }
+
+  /// \f$ J_\delta = \partial (x \oplus \delta) / \partial (t_\delta, \theta_\delta) \f$
+  /// = diag(R(θ), 1): how increment errors (body frame) enter the state.
+  [[nodiscard]] Matrix3 jacobian_increment(const State& x, const Control& d) const noexcept {
+    typename SE2<T>::ActJacobianPoint J_t_d;
+    (void)as_se2(x).act(d.translation(), nullptr, &J_t_d);
+    Matrix3 J = Matrix3::Identity();
+    J.template topLeftCorner<2, 2>() = J_t_d;
+    return J;
+  }
+
+  /// The diagonal of \f$ Q_\delta \f$ for increment δ (m², m², rad²).
+  [[nodiscard]] Vector3 increment_variance(const Control& d) const noexcept {
+    const T s = std::hypot(d.x(), d.y()), dth = std::abs(d.angle());
+    const T kxy = n_.xy_sigma_per_sqrt_m, kts = n_.theta_sigma_per_sqrt_m,
+            ktt = n_.theta_sigma_per_sqrt_rad;
+    return {kxy * kxy * s, kxy * kxy * s, kts * kts * s + ktt * ktt * dth};
+  }
+
+  /// \f$ Q = J_\delta Q_\delta J_\delta^\top \f$ (world frame, m² / rad²).
+  [[nodiscard]] Matrix3 noise(const State& x, const Control& d, T /*dt_s*/) const noexcept {
+    const Matrix3 Jd = jacobian_increment(x, d);
+    return Jd * increment_variance(d).asDiagonal() * Jd.transpose();
+  }
+
+  /// The noise rates.
+  [[nodiscard]] const Se2OdometryNoise<T>& noise_rates() const noexcept { return n_; }
+
+ private:
+  Se2OdometryNoise<T> n_;
+};
+
+static_assert(MotionModel<Se2Odometry<double>>);
+static_assert(MotionModel<Se2Odometry<float>>);
+
+}  // namespace posefuse
