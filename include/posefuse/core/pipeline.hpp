@@ -145,10 +145,25 @@ template <class... Stages>
                     std::tuple_cat(detail::Flatten<Stages>::apply(std::move(stages))...));
 }
 
-/// `a | b` is `make_pipeline(a, b)`.
-template <Stage A, Stage B>
+}  // namespace posefuse
+
+/// `a | b` is `posefuse::make_pipeline(a, b)` for any two stages.
+///
+/// It is declared in the global namespace, constrained to posefuse::Stage
+/// operands, so that it is found for stages defined in *any* namespace:
+/// ordinary lookup reaches the global namespace from everywhere, whereas a
+/// function in namespace posefuse would only be found for posefuse's own
+/// types (argument-dependent lookup). One C++ rule still applies: a
+/// namespace that declares an `operator|` of its own (e.g. for flag enums)
+/// hides this one inside that namespace; write `using ::operator|;` there, or
+/// call posefuse::make_pipeline.
+template <posefuse::Stage A, posefuse::Stage B>
 [[nodiscard]] auto operator|(A a, B b) {
-  return make_pipeline(std::move(a), std::move(b));
+  return posefuse::make_pipeline(std::move(a), std::move(b));
 }
 
+namespace posefuse {
+/// The same operator under posefuse's name, so existing
+/// `using posefuse::operator|;` lines keep working (it is one function).
+using ::operator|;
 }  // namespace posefuse
