@@ -7,11 +7,15 @@
 // Four methods run on the same data: SLAM alone, odometry alone (wheels +
 // IMU, the seed's O_m), the seed's threshold fuser (eq 14-15 as printed) and
 // the gated fuser (covariance weighting, gates, re-anchoring). Without
-// --log it simulates the run (posefuse/sim/corridor.hpp documents every noise
+// --log it simulates the run (apps/sim/corridor.hpp documents every noise
 // figure); with --log DIR it runs on a recorded log folder (wheels.csv,
 // imu.csv, slam.csv, robot.txt, optional groundtruth.csv).
 //
 // Usage: corridor_fusion [--seed N | --log DIR] [--write-log DIR] [--json] [--svg FILE]
+// (see --help). Exit status 0 ok, 1 bad data (one line on stderr naming
+// file:line of the log file at fault, or an output that cannot be written),
+// 2 bad usage. --write-log and --svg are written only after the run
+// succeeded, each file through a temporary.
 //
 // Expected output (default: simulation, seed 1):
 //
@@ -36,31 +40,25 @@
 // --json under "warnings".
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
-#include <cstdlib>
-#include <exception>
 #include <filesystem>
-#include <fstream>
-#include <limits>
+#include <iostream>
 #include <optional>
 #include <string>
 #include <string_view>
 
-#include <posefuse/fusion/corridor_runner.hpp>
+#include <apps/cli.hpp>
+#include <apps/corridor_runner.hpp>
+#include <apps/json.hpp>
+#include <apps/output_file.hpp>
+#include <apps/sim/corridor.hpp>
+#include <apps/svg.hpp>
 #include <posefuse/io/robot_log.hpp>
-#include <posefuse/sim/corridor.hpp>
 
 namespace {
 
-constexpr const char* kUsage =
-    "usage: corridor_fusion [--seed N | --log DIR] [--write-log DIR] [--json] [--svg FILE]\n"
-    "  --seed N         simulate the corridor with RNG seed N (default 1)\n"
-    "  --log DIR        run on a recorded log folder (wheels.csv, imu.csv, slam.csv,\n"
-    "                   robot.txt, optional groundtruth.csv)\n"
-    "  --write-log DIR  save the simulated log to DIR (simulation only)\n"
-    "  --json           print the figures as JSON instead of the table\n"
-    "  --svg FILE       write the four paths (and ground truth) as an SVG plot\n"
-    "  --help           this text\n";
+namespace apps = posefuse::apps;
 
 struct Options {
   std::optional<std::uint64_t> seed;
@@ -68,47 +66,35 @@ struct Options {
   bool json = false;
 };
 
-[[noreturn]] void fail(const std::string& reason) {
-  std::fprintf(stderr, "corridor_fusion: %s\n", reason.c_str());
-  std::exit(1);
-}
-
-Options parse(int argc, char** argv) {
+/// The options, or nothing when --help was printed.
+std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view a = argv[i];
-    const auto value = [&]() -> std::string {
-      if (i + 1 >= argc) fail("option " + std::string(a) + " needs a value");
-      return argv[++i];
-    };
-    if (a == "--help" || a == "-h") {
-      std::fputs(kUsage, stdout);
-      std::exit(0);
-    } else if (a == "--seed") {
-      const std::string v = value();
-      char* end = nullptr;
-      const unsigned long long n = std::strtoull(v.c_str(), &end, 10);
-      if (v.empty() || *end != '\0' || v[0] == '-') fail("--seed needs a non-negative integer, got '" + v + "'");
-      o.seed = n;
-    } else if (a == "--log") {
-      o.log = value();
-    } else if (a == "--write-log") {
-      o.write_log = value();
-    } else if (a == "--svg") {
-      o.svg = value();
-    } else if (a == "--json") {
-      o.json = true;
-    } else {
-      fail("unknown option '" + std::string(a) + "' (see --help)");
-    }
-  }
-  if (o.log && o.seed) fail("--seed and --log exclude each other");
-  if (o.log && o.write_log) fail("--write-log saves a simulated log; it cannot be used with --log");
+  apps::Parser cli(cmd.program, "[--seed N | --log DIR] [--write-log DIR] [--json] [--svg FILE]",
+                   "Seed 001's corridor experiment: SLAM alone, odometry alone, the seed's threshold "
+                   "fuser\nand the gated fuser on one simulated or recorded run.");
+  cli.integer({.name = "--seed", .value = "N", .help = "simulate the corridor with RNG seed N",
+               .default_text = "1"},
+              o.seed, std::uint64_t{0});
+  cli.path({.name = "--log", .value = "DIR",
+            .help = "run on a recorded log folder (wheels.csv, imu.csv, slam.csv,\n"
+                    "robot.txt, optional groundtruth.csv)"},
+           o.log);
+  cli.path({.name = "--write-log", .value = "DIR", .help = "save the simulated log to DIR (simulation only)"},
+           o.write_log);
+  cli.flag({.name = "--json", .help = "print the figures as JSON instead of the table"}, o.json);
+  cli.path({.name = "--svg", .value = "FILE", .help = "write the four paths (and ground truth) as an SVG plot"},
+           o.svg);
+  cli.epilogue("Exit status: 0 ok, 1 bad data (file:line of the log file at fault), 2 bad usage.");
+  if (!cli.parse(cmd)) return std::nullopt;
+  if (o.log && o.seed) throw apps::usage_error("--seed and --log exclude each other");
+  if (o.log && o.write_log)
+    throw apps::usage_error("--write-log saves a simulated log; it cannot be used with --log");
   return o;
 }
 
+/// `v` with `prec` decimals, or "n/a" when it is not finite.
 std::string num(double v, int prec) {
-  if (!std::isfinite(v)) return "null";
+  if (!std::isfinite(v)) return "n/a";
   char b[64];
   std::snprintf(b, sizeof b, "%.*f", prec, v);
   return b;
@@ -125,10 +111,9 @@ void print_table(const posefuse::CorridorRunResult& r, const std::string& source
   for (std::size_t k = 0; k < 4; ++k) {
     const auto& m = r.metrics[k];
     std::printf("%-14s  %16s  %8s  %11.1f  %17s  %17s\n", kCorridorMethodNames[k],
-                m.poses ? num(m.loop_closure_error_m, 3).c_str() : "no pose",
-                std::isfinite(m.rmse_m) ? num(m.rmse_m, 3).c_str() : "n/a", m.time_without_pose_s,
-                std::isfinite(m.max_yaw_error_deg) ? num(m.max_yaw_error_deg, 1).c_str() : "n/a",
-                std::isfinite(m.max_yaw_error_all_deg) ? num(m.max_yaw_error_all_deg, 1).c_str() : "n/a");
+                m.poses ? num(m.loop_closure_error_m, 3).c_str() : "no pose", num(m.rmse_m, 3).c_str(),
+                m.time_without_pose_s, num(m.max_yaw_error_deg, 1).c_str(),
+                num(m.max_yaw_error_all_deg, 1).c_str());
   }
   std::printf("\nyaw error after each 90-degree turn (deg; seed 001 reports about 1.9):\n");
   for (std::size_t k = 0; k < 4; ++k) {
@@ -158,109 +143,88 @@ void print_table(const posefuse::CorridorRunResult& r, const std::string& source
   for (const auto& w : r.warnings) std::printf("warning: %s\n", w.c_str());
 }
 
-std::string json_escape(const std::string& s) {
-  std::string o;
-  for (const char c : s) {
-    if (c == '"' || c == '\\') o += '\\';
-    if (static_cast<unsigned char>(c) >= 0x20) o += c;
-  }
-  return o;
-}
-
+/// The figures as JSON (numbers round-trip; a figure that does not exist is null).
 void print_json(const posefuse::CorridorRunResult& r, const std::string& source) {
-  std::printf("{\n  \"source\": \"%s\",\n  \"duration_s\": %s,\n  \"turns\": %zu,\n", json_escape(source).c_str(),
-              num(r.duration_s, 3).c_str(), r.turns.size());
-  std::printf("  \"turns_from_groundtruth\": %s,\n  \"methods\": {\n",
-              r.turns_from_groundtruth ? "true" : "false");
+  using Layout = apps::JsonWriter::Layout;
+  apps::JsonWriter j(std::cout);
+  j.begin_object();
+  j.member("source", source).member("duration_s", r.duration_s).member("turns", r.turns.size());
+  j.member("turns_from_groundtruth", r.turns_from_groundtruth);
+  j.key("methods").begin_object();
   for (std::size_t k = 0; k < 4; ++k) {
     const auto& m = r.metrics[k];
-    std::printf("    \"%s\": {\"loop_closure_error\": %s, \"rmse\": %s, \"time_without_pose_s\": %s, "
-                "\"max_yaw_error_deg\": %s, \"max_yaw_error_all_deg\": %s, \"yaw_error_after_turn_deg\": [",
-                posefuse::kCorridorMethodNames[k], num(m.loop_closure_error_m, 4).c_str(),
-                num(m.rmse_m, 4).c_str(), num(m.time_without_pose_s, 3).c_str(),
-                num(m.max_yaw_error_deg, 3).c_str(), num(m.max_yaw_error_all_deg, 3).c_str());
-    for (std::size_t i = 0; i < m.yaw_error_after_turn_deg.size(); ++i)
-      std::printf("%s%s", i ? ", " : "", num(m.yaw_error_after_turn_deg[i], 3).c_str());
-    std::printf("], \"poses\": %zu}%s\n", m.poses, k < 3 ? "," : "");
+    j.key(posefuse::kCorridorMethodNames[k]).begin_object(Layout::kInline);
+    j.member("loop_closure_error", m.loop_closure_error_m).member("rmse", m.rmse_m);
+    j.member("time_without_pose_s", m.time_without_pose_s);
+    j.member("max_yaw_error_deg", m.max_yaw_error_deg).member("max_yaw_error_all_deg", m.max_yaw_error_all_deg);
+    j.key("yaw_error_after_turn_deg").begin_array();
+    for (const double e : m.yaw_error_after_turn_deg) j.value(e);
+    j.end_array().member("poses", m.poses).end_object();
   }
-  std::printf("  },\n  \"slam\": {\"valid\": %d, \"lost\": %d, \"reinit\": %d, \"tilted\": %d},\n",
-              r.slam_valid, r.slam_lost, r.slam_reinit, r.slam_tilted);
-  std::printf("  \"seed_fuser\": {\"averaged\": %d, \"fallback\": %d},\n", r.seed_averaged,
-              r.seed_fallback);
-  std::printf("  \"gated_fuser\": {\"fused\": %d, \"rejected\": %d, \"anchors\": %d},\n",
-              r.gated_fused, r.gated_rejected, r.gated_anchors);
-  std::printf("  \"magnetometer_calibrated\": %s,\n  \"magnetometer_note\": \"%s\",\n",
-              r.magnetometer_calibrated ? "true" : "false", json_escape(r.magnetometer_note).c_str());
-  std::printf("  \"attitude_stale_s\": %s,\n  \"warnings\": [", num(r.attitude_stale_s, 3).c_str());
-  for (std::size_t i = 0; i < r.warnings.size(); ++i)
-    std::printf("%s\n    \"%s\"", i ? "," : "", json_escape(r.warnings[i]).c_str());
-  std::printf("%s]\n}\n", r.warnings.empty() ? "" : "\n  ");
+  j.end_object();
+  j.key("slam").begin_object(Layout::kInline);
+  j.member("valid", r.slam_valid).member("lost", r.slam_lost).member("reinit", r.slam_reinit);
+  j.member("tilted", r.slam_tilted).end_object();
+  j.key("seed_fuser").begin_object(Layout::kInline);
+  j.member("averaged", r.seed_averaged).member("fallback", r.seed_fallback).end_object();
+  j.key("gated_fuser").begin_object(Layout::kInline);
+  j.member("fused", r.gated_fused).member("rejected", r.gated_rejected);
+  j.member("anchors", r.gated_anchors).end_object();
+  j.member("magnetometer_calibrated", r.magnetometer_calibrated);
+  j.member("magnetometer_note", r.magnetometer_note);
+  j.member("attitude_stale_s", r.attitude_stale_s);
+  j.key("warnings").begin_array(Layout::kBlock);
+  for (const auto& w : r.warnings) j.value(w);
+  j.end_array().end_object().finish();
 }
 
-void write_svg(const std::filesystem::path& file, const posefuse::CorridorRunResult& r) {
-  double x0 = std::numeric_limits<double>::max(), y0 = x0, x1 = -x0, y1 = -x0;
-  const auto grow = [&](const posefuse::PlanarTrack& t) {
-    for (const auto& p : t) {
-      x0 = std::min(x0, p.pose.x), x1 = std::max(x1, p.pose.x);
-      y0 = std::min(y0, p.pose.y), y1 = std::max(y1, p.pose.y);
-    }
-  };
-  grow(r.groundtruth);
-  for (const auto& t : r.tracks) grow(t);
-  if (!(x1 > x0) || !(y1 > y0)) x0 = y0 = -1, x1 = y1 = 1;
-  const double W = 800, margin = 40, s = (W - 2 * margin) / std::max(x1 - x0, y1 - y0);
-  const double H = (y1 - y0) * s + 2 * margin + 90;
-  std::ofstream out(file);
-  if (!out) fail("cannot write " + file.string());
-  out << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << W << "\" height=\"" << H
-      << "\" viewBox=\"0 0 " << W << ' ' << H << "\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
-  const auto path = [&](const posefuse::PlanarTrack& t, const char* colour, double width, const char* dash) {
-    if (t.empty()) return;
-    out << "<polyline fill=\"none\" stroke=\"" << colour << "\" stroke-width=\"" << width << "\""
-        << (dash[0] ? " stroke-dasharray=\"" : "") << dash << (dash[0] ? "\"" : "") << " points=\"";
-    for (const auto& p : t)
-      out << num(margin + (p.pose.x - x0) * s, 1) << ',' << num(margin + (y1 - p.pose.y) * s, 1) << ' ';
-    out << "\"/>\n";
-  };
+/// The paths of the four methods and the ground truth, x-y in metres.
+std::string paths_svg(const posefuse::CorridorRunResult& r, const std::string& source) {
+  apps::svg::Plot plot("corridor_fusion: " + source);
+  plot.x_axis("x", "m").y_axis("y", "m").equal_aspect();
+  if (!r.groundtruth.empty()) plot.line("ground truth", r.groundtruth.positions(), {"#000000", 3.0, {}});
   const char* colours[4] = {"#d62728", "#ff7f0e", "#9467bd", "#1f77b4"};
-  path(r.groundtruth, "#000000", 3, "");
-  for (std::size_t k = 0; k < 4; ++k) path(r.tracks[k], colours[k], 1.5, k == 0 ? "" : k == 2 ? "6,3" : "");
-  double ly = (y1 - y0) * s + 2 * margin + 10;
-  const auto legend = [&](const char* colour, const std::string& text) {
-    out << "<line x1=\"" << margin << "\" y1=\"" << ly << "\" x2=\"" << margin + 30 << "\" y2=\"" << ly
-        << "\" stroke=\"" << colour << "\" stroke-width=\"3\"/><text x=\"" << margin + 40 << "\" y=\""
-        << ly + 5 << "\" font-family=\"sans-serif\" font-size=\"14\">" << text << "</text>\n";
-    ly += 16;
-  };
-  if (!r.groundtruth.empty()) legend("#000000", "ground truth");
   for (std::size_t k = 0; k < 4; ++k)
-    legend(colours[k], std::string(posefuse::kCorridorMethodNames[k]) + " (loop closure " +
-                           num(r.metrics[k].loop_closure_error_m, 2) + " m)");
-  out << "</svg>\n";
+    plot.line(std::string(posefuse::kCorridorMethodNames[k]) + " (loop closure " +
+                  num(r.metrics[k].loop_closure_error_m, 2) + " m)",
+              r.tracks[k].positions(), {colours[k], 1.5, k == 2 ? "6,3" : ""});
+  apps::svg::Document doc(800, 720);
+  doc.plot(plot, {0, 0, 800, 720});
+  return doc.str();
+}
+
+int run(const Options& o) {
+  // 1. Compute: read or simulate the log, run the four methods.
+  posefuse::RobotLog log;
+  std::string source;
+  if (o.log) {
+    log = posefuse::read_robot_log(*o.log);
+    source = "log " + o.log->string();
+  } else {
+    const std::uint64_t seed = o.seed.value_or(1);
+    log = posefuse::simulate_corridor({}, seed).log;
+    source = "simulation, seed " + std::to_string(seed);
+  }
+  const posefuse::CorridorRunResult r = posefuse::run_corridor(log);
+
+  // 2. Write the files (all or none), then the report.
+  apps::OutputFiles files;
+  if (o.write_log)
+    files.add_folder(*o.write_log, [&log](const std::filesystem::path& dir) {
+      posefuse::write_robot_log(dir, log);
+    });
+  if (o.svg) files.add(*o.svg, paths_svg(r, source));
+  files.commit();
+  if (o.json) print_json(r, source);
+  else print_table(r, source);
+  return 0;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  const Options opt = parse(argc, argv);
-  try {
-    posefuse::RobotLog log;
-    std::string source;
-    if (opt.log) {
-      log = posefuse::read_robot_log(*opt.log);
-      source = "log " + opt.log->string();
-    } else {
-      const std::uint64_t seed = opt.seed.value_or(1);
-      log = posefuse::simulate_corridor({}, seed).log;
-      source = "simulation, seed " + std::to_string(seed);
-      if (opt.write_log) posefuse::write_robot_log(*opt.write_log, log);
-    }
-    const posefuse::CorridorRunResult r = posefuse::run_corridor(log);
-    if (opt.json) print_json(r, source);
-    else print_table(r, source);
-    if (opt.svg) write_svg(*opt.svg, r);
-  } catch (const std::exception& e) {
-    fail(e.what());
-  }
-  return 0;
+  return apps::run_main(argc, argv, [](const apps::CommandLine& cmd) {
+    const std::optional<Options> o = parse_options(cmd);
+    return o ? run(*o) : 0;
+  });
 }

@@ -30,53 +30,27 @@
 //
 // prints rmse 12.978526 m and "scale 24.841695". Add --metric rpe --delta 100
 // --delta-unit m for the relative error per 100 m, --json for machine-readable
-// output. Bad input exits with 2 (usage) or 1 (data), one line on stderr.
+// output. Bad input exits with 2 (usage) or 1 (data, naming file:line where
+// a file is at fault), one line on stderr.
 
-#include <charconv>
 #include <cmath>
 #include <cstdio>
-#include <exception>
 #include <filesystem>
+#include <iostream>
 #include <optional>
 #include <string>
 #include <string_view>
-#include <system_error>
 #include <vector>
 
+#include <apps/cli.hpp>
+#include <apps/json.hpp>
 #include <posefuse/eval/metrics.hpp>
 #include <posefuse/io/association.hpp>
 #include <posefuse/io/formats.hpp>
 
 namespace {
 
-constexpr const char* kUsage =
-    "usage: evaluate_trajectory --groundtruth REF --estimate EST [options]\n"
-    "\n"
-    "Absolute (APE) or relative (RPE) pose error of EST against REF, as evo_ape / evo_rpe.\n"
-    "\n"
-    "  --groundtruth FILE       reference trajectory\n"
-    "  --estimate FILE          estimated trajectory\n"
-    "  --format kitti|tum       format of both files (default kitti)\n"
-    "  --groundtruth-format F   format of REF only (overrides --format)\n"
-    "  --estimate-format F      format of EST only (overrides --format)\n"
-    "  --times FILE             KITTI times.txt, stamps every KITTI file given\n"
-    "  --metric ape|rpe         default ape\n"
-    "  --align none|se3|sim3    Umeyama alignment of EST to REF (default none)\n"
-    "  --pose-relation R        trans (default), angle_deg, angle_rad or full\n"
-    "  --delta N                RPE step (default 1)\n"
-    "  --delta-unit frames|m    RPE step unit (default frames)\n"
-    "  --max-time-diff S        association tolerance in seconds (default 0.01)\n"
-    "  --json                   print one JSON object instead of the table\n"
-    "  --help                   print this help\n"
-    "\n"
-    "Two KITTI files without --times are compared frame by frame (equal counts);\n"
-    "otherwise poses are associated by timestamp like evo's --t_max_diff.\n"
-    "Exit status: 0 ok, 1 bad data, 2 bad usage.\n";
-
-/// A command-line mistake: exit code 2.
-struct UsageError {
-  std::string message;
-};
+namespace apps = posefuse::apps;
 
 struct Options {
   std::filesystem::path groundtruth, estimate;
@@ -90,96 +64,70 @@ struct Options {
   posefuse::DeltaUnit delta_unit = posefuse::DeltaUnit::kFrames;
   double max_time_diff = 0.01;
   bool json = false;
-  bool help = false;
 };
 
-double parse_double(std::string_view flag, std::string_view text) {
-  double v = 0.0;
-  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-  if (ec != std::errc{} || ptr != text.data() + text.size() || !std::isfinite(v)) {
-    throw UsageError{std::string(flag) + " expects a number, got '" + std::string(text) + "'"};
-  }
-  return v;
-}
-
-// Runs a posefuse parse_* function, turning its invalid_argument into a usage error.
-template <class F>
-auto parse_value(std::string_view flag, F&& parse) {
-  try {
-    return parse();
-  } catch (const posefuse::invalid_argument& e) {
-    throw UsageError{std::string(flag) + ": " + e.what()};
-  }
-}
-
-Options parse_args(int argc, char** argv) {
+/// The options, or nothing when --help was printed.
+std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   Options o;
+  std::optional<std::filesystem::path> ref, est;
   std::optional<posefuse::Format> format, ref_format, est_format;
-  bool have_ref = false, have_est = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view flag = argv[i];
-    if (flag == "--help" || flag == "-h") {
-      o.help = true;
-      return o;
-    }
-    if (flag == "--json") {
-      o.json = true;
-      continue;
-    }
-    if (flag.substr(0, 2) != "--")
-      throw UsageError{"unexpected argument '" + std::string(flag) + "'"};
-    if (i + 1 >= argc) throw UsageError{std::string(flag) + " needs a value"};
-    const std::string_view value = argv[++i];
-    if (flag == "--groundtruth") {
-      o.groundtruth = value;
-      have_ref = true;
-    } else if (flag == "--estimate") {
-      o.estimate = value;
-      have_est = true;
-    } else if (flag == "--times") {
-      o.times = std::filesystem::path(value);
-    } else if (flag == "--format") {
-      format = parse_value(flag, [&] { return posefuse::parse_format(value); });
-    } else if (flag == "--groundtruth-format") {
-      ref_format = parse_value(flag, [&] { return posefuse::parse_format(value); });
-    } else if (flag == "--estimate-format") {
-      est_format = parse_value(flag, [&] { return posefuse::parse_format(value); });
-    } else if (flag == "--metric") {
-      if (value != "ape" && value != "rpe") {
-        throw UsageError{"--metric expects ape or rpe, got '" + std::string(value) + "'"};
-      }
-      o.metric_rpe = value == "rpe";
-    } else if (flag == "--align") {
-      o.align = parse_value(flag, [&] { return posefuse::parse_alignment(value); });
-    } else if (flag == "--pose-relation") {
-      o.relation = parse_value(flag, [&] { return posefuse::parse_pose_relation(value); });
-    } else if (flag == "--delta") {
-      o.delta = parse_double(flag, value);
-    } else if (flag == "--delta-unit") {
-      o.delta_unit = parse_value(flag, [&] { return posefuse::parse_delta_unit(value); });
-    } else if (flag == "--max-time-diff") {
-      o.max_time_diff = parse_double(flag, value);
-      if (o.max_time_diff < 0.0) throw UsageError{"--max-time-diff must be >= 0"};
-    } else {
-      throw UsageError{"unknown option '" + std::string(flag) + "'"};
-    }
-  }
-  if (!have_ref || !have_est) throw UsageError{"--groundtruth and --estimate are required"};
+  const auto format_flag = [](std::optional<posefuse::Format>& f) {
+    return [&f](std::string_view v) { f = posefuse::parse_format(v); };
+  };
+  apps::Parser cli(cmd.program, "--groundtruth REF --estimate EST [options]",
+                   "Absolute (APE) or relative (RPE) pose error of EST against REF, as evo_ape / "
+                   "evo_rpe.");
+  cli.path({.name = "--groundtruth", .value = "FILE", .help = "reference trajectory (required)"}, ref);
+  cli.path({.name = "--estimate", .value = "FILE", .help = "estimated trajectory (required)"}, est);
+  cli.custom({.name = "--format", .value = "kitti|tum", .help = "format of both files",
+              .default_text = "kitti"},
+             format_flag(format));
+  cli.custom({.name = "--groundtruth-format", .value = "F",
+              .help = "format of REF only (overrides --format)"},
+             format_flag(ref_format));
+  cli.custom({.name = "--estimate-format", .value = "F",
+              .help = "format of EST only (overrides --format)"},
+             format_flag(est_format));
+  cli.path({.name = "--times", .value = "FILE", .help = "KITTI times.txt, stamps every KITTI file given"},
+           o.times);
+  cli.custom({.name = "--metric", .value = "ape|rpe", .help = "the error", .default_text = "ape"},
+             [&](std::string_view v) {
+               if (v != "ape" && v != "rpe")
+                 throw apps::usage_error("expected ape or rpe, got '" + std::string(v) + "'");
+               o.metric_rpe = v == "rpe";
+             });
+  cli.custom({.name = "--align", .value = "none|se3|sim3", .help = "Umeyama alignment of EST to REF",
+              .default_text = "none"},
+             [&](std::string_view v) { o.align = posefuse::parse_alignment(v); });
+  cli.custom({.name = "--pose-relation", .value = "R",
+              .help = "trans, angle_deg, angle_rad or full", .default_text = "trans"},
+             [&](std::string_view v) { o.relation = posefuse::parse_pose_relation(v); });
+  cli.real({.name = "--delta", .value = "N", .help = "RPE step"}, o.delta, apps::Domain::kPositive);
+  cli.custom({.name = "--delta-unit", .value = "frames|m", .help = "RPE step unit",
+              .default_text = "frames"},
+             [&](std::string_view v) { o.delta_unit = posefuse::parse_delta_unit(v); });
+  cli.real({.name = "--max-time-diff", .value = "S", .help = "association tolerance", .unit = "s"},
+           o.max_time_diff, apps::Domain::kNonNegative);
+  cli.flag({.name = "--json", .help = "print one JSON object instead of the table"}, o.json);
+  cli.epilogue(
+      "Two KITTI files without --times are compared frame by frame (equal counts);\n"
+      "otherwise poses are associated by timestamp like evo's --t_max_diff.\n"
+      "Exit status: 0 ok, 1 bad data (file:line where a file is at fault), 2 bad usage.");
+  if (!cli.parse(cmd)) return std::nullopt;
+
+  if (!ref || !est) throw apps::usage_error("--groundtruth and --estimate are required");
+  o.groundtruth = *ref;
+  o.estimate = *est;
   o.ref_format = ref_format.value_or(format.value_or(posefuse::Format::kKitti));
   o.est_format = est_format.value_or(format.value_or(posefuse::Format::kKitti));
   const bool any_kitti =
       o.ref_format == posefuse::Format::kKitti || o.est_format == posefuse::Format::kKitti;
-  if (o.times && !any_kitti) throw UsageError{"--times only applies to KITTI files"};
-  if (o.ref_format != o.est_format && !o.times) {
-    throw UsageError{"comparing a KITTI with a TUM file needs --times for the KITTI one"};
-  }
+  if (o.times && !any_kitti) throw apps::usage_error("--times only applies to KITTI files");
+  if (o.ref_format != o.est_format && !o.times)
+    throw apps::usage_error("comparing a KITTI with a TUM file needs --times for the KITTI one");
   if (o.delta_unit == posefuse::DeltaUnit::kFrames &&
-      (o.delta < 1.0 || o.delta != std::floor(o.delta))) {
-    throw UsageError{"--delta in frames must be an integer >= 1"};
-  }
-  if (o.delta_unit == posefuse::DeltaUnit::kMeters && !(o.delta > 0.0)) {
-    throw UsageError{"--delta in metres must be > 0"};
-  }
+      (o.delta < 1.0 || o.delta != std::floor(o.delta)))
+    throw apps::usage_error("--delta in frames must be an integer >= 1");
   return o;
 }
 
@@ -230,22 +178,23 @@ void print_table(const Options& o, const posefuse::MetricResult& r, std::size_t 
   if (o.align == posefuse::Alignment::kSim3) std::printf("scale  %11.6f\n", r.alignment.scale);
 }
 
+/// One JSON object on one line; numbers round-trip, non-finite ones are null.
 void print_json(const Options& o, const posefuse::MetricResult& r) {
   const posefuse::Statistics& s = r.stats;
-  std::printf(
-      "{\"metric\": \"%s\", \"pose_relation\": \"%s\", \"unit\": \"%s\", \"alignment\": \"%s\", "
-      "\"scale\": %.17g, ",
-      o.metric_rpe ? "rpe" : "ape", std::string(relation_name(o.relation)).c_str(),
-      std::string(posefuse::unit_of(o.relation)).c_str(),
-      std::string(posefuse::to_string(o.align)).c_str(), r.alignment.scale);
+  apps::JsonWriter j(std::cout);
+  j.begin_object(apps::JsonWriter::Layout::kInline);
+  j.member("metric", o.metric_rpe ? "rpe" : "ape")
+      .member("pose_relation", relation_name(o.relation))
+      .member("unit", posefuse::unit_of(o.relation))
+      .member("alignment", posefuse::to_string(o.align))
+      .member("scale", r.alignment.scale);
   if (o.metric_rpe) {
-    std::printf("\"delta\": %.17g, \"delta_unit\": \"%s\", ", o.delta,
-                o.delta_unit == posefuse::DeltaUnit::kFrames ? "frames" : "m");
+    j.member("delta", o.delta)
+        .member("delta_unit", o.delta_unit == posefuse::DeltaUnit::kFrames ? "frames" : "m");
   }
-  std::printf(
-      "\"count\": %zu, \"rmse\": %.17g, \"mean\": %.17g, \"median\": %.17g, \"std\": %.17g, "
-      "\"min\": %.17g, \"max\": %.17g, \"sse\": %.17g}\n",
-      s.count, s.rmse, s.mean, s.median, s.std, s.min, s.max, s.sse);
+  j.member("count", s.count).member("rmse", s.rmse).member("mean", s.mean).member("median", s.median);
+  j.member("std", s.std).member("min", s.min).member("max", s.max).member("sse", s.sse);
+  j.end_object().finish();
 }
 
 int run(const Options& o) {
@@ -256,9 +205,9 @@ int run(const Options& o) {
                               o.est_format == posefuse::Format::kKitti && !o.times;
   if (frame_by_frame) {
     if (ref.size() != est.size()) {
-      throw posefuse::invalid_argument("reference has " + std::to_string(ref.size()) +
-                                       " poses but estimate " + std::to_string(est.size()) +
-                                       "; KITTI files without --times are compared frame by frame");
+      throw apps::data_error("reference has " + std::to_string(ref.size()) +
+                             " poses but estimate " + std::to_string(est.size()) +
+                             "; KITTI files without --times are compared frame by frame");
     }
     ref_sync = ref;
     est_sync = est;
@@ -289,21 +238,8 @@ int run(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  Options options;
-  try {
-    options = parse_args(argc, argv);
-  } catch (const UsageError& e) {
-    std::fprintf(stderr, "evaluate_trajectory: %s (see --help)\n", e.message.c_str());
-    return 2;
-  }
-  if (options.help) {
-    std::fputs(kUsage, stdout);
-    return 0;
-  }
-  try {
-    return run(options);
-  } catch (const std::exception& e) {  // io_error names file:line; invalid_argument the reason
-    std::fprintf(stderr, "evaluate_trajectory: %s\n", e.what());
-    return 1;
-  }
+  return apps::run_main(argc, argv, [](const apps::CommandLine& cmd) {
+    const std::optional<Options> o = parse_options(cmd);
+    return o ? run(*o) : 0;
+  });
 }

@@ -13,7 +13,7 @@
 //
 // With no arguments it runs on a built-in synthetic drive (a KITTI-06-like
 // 1.2 km loop with heading drift, scale error and 0.35 m position jitter;
-// include/posefuse/sim/kitti_like_drive.hpp) and prints:
+// examples/apps/sim/kitti_like_drive.hpp) and prints:
 //
 //   estimate     method    RMSE before [m]  RMSE after [m]  reduction   verdict
 //   synthetic    seed000             1.150           1.150     0.00 %   returns its input (SPEC.md A)
@@ -28,73 +28,36 @@
 //   orb_trajectory_correction --groundtruth groundtruth.txt --times times.txt
 //       --estimate orbslam2_stereo.txt --estimate cvo_vo.txt --plot kitti06.svg
 //
-// Options: see --help. Bad input: exit 2 (usage) or 1 (data), one line on stderr.
+// Options: see --help. Exit status 0 ok, 1 bad data (one line on stderr,
+// naming file:line where a file is at fault; also a filter step that was not
+// applied or a non-finite result), 2 bad usage. --out and --plot are written
+// only when everything was computed, each through a temporary file.
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
+#include <iostream>
 #include <optional>
+#include <set>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include <apps/cli.hpp>
+#include <apps/json.hpp>
+#include <apps/output_file.hpp>
+#include <apps/sim/kitti_like_drive.hpp>
+#include <apps/svg.hpp>
+#include <apps/trajectory_correction.hpp>
 #include <posefuse/eval/alignment.hpp>
 #include <posefuse/eval/metrics.hpp>
-#include <posefuse/filters/trajectory_correction.hpp>
 #include <posefuse/io/association.hpp>
 #include <posefuse/io/formats.hpp>
-#include <posefuse/sim/kitti_like_drive.hpp>
 
 namespace {
 
 using namespace posefuse;
-
-constexpr const char* kUsage =
-    "usage: orb_trajectory_correction [--groundtruth REF --estimate EST [--estimate EST2 ...]]\n"
-    "                                 [options]\n"
-    "\n"
-    "Filters SLAM trajectories on the road plane (seed 000) and compares the planar RMSE\n"
-    "against ground truth before and after. Without files it uses a built-in synthetic drive.\n"
-    "\n"
-    "  --groundtruth FILE     reference trajectory\n"
-    "  --estimate FILE        trajectory to correct (repeat for several)\n"
-    "  --format kitti|tum     format of all files (default kitti)\n"
-    "  --times FILE           KITTI times.txt for the ground truth and KITTI estimates\n"
-    "  --plane xz|xy|yz       road plane (default xz: KITTI camera frame)\n"
-    "  --R VAR[,VAR]          seed's process noise R = diag (m^2/frame, default 0.01)\n"
-    "  --Q VAR[,VAR]          seed's measurement noise Q = diag (m^2, default 0.25)\n"
-    "  --cv-q Q               constant-velocity acceleration noise (m^2/s^3, default 1)\n"
-    "  --align none|se3|sim3  align each estimate to the ground truth first (default none)\n"
-    "  --max-time-diff S      TUM timestamp association tolerance (default 0.01 s)\n"
-    "  --method seed000|cv|cv+rts  corrector whose output --out writes (default seed000)\n"
-    "  --out PATH             write the corrected trajectory (input format); with several\n"
-    "                         estimates PATH is a folder\n"
-    "  --plot FILE.svg        paths (truth, raw, corrected) and covariance over time (Fig. 8)\n"
-    "  --json                 print the results as JSON instead of a table\n"
-    "  --help                 this text\n";
-
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-double parse_double(std::string_view flag, std::string_view text) {
-  double v = 0;
-  const auto [p, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-  if (ec != std::errc{} || p != text.data() + text.size() || !std::isfinite(v))
-    throw UsageError(std::string(flag) + ": '" + std::string(text) + "' is not a finite number");
-  return v;
-}
-
-Eigen::Matrix2d parse_diag(std::string_view flag, std::string_view text) {
-  const auto comma = text.find(',');
-  const double a = parse_double(flag, text.substr(0, comma));
-  const double b = comma == std::string_view::npos ? a : parse_double(flag, text.substr(comma + 1));
-  if (!(a > 0 && b > 0)) throw UsageError(std::string(flag) + ": variances must be > 0");
-  return Eigen::Vector2d(a, b).asDiagonal();
-}
 
 struct Options {
   std::optional<std::filesystem::path> groundtruth, times, out, plot;
@@ -110,45 +73,83 @@ struct Options {
   bool json = false;
 };
 
-Options parse_args(int argc, char** argv) {
+/// "VAR" or "VAR,VAR": a diagonal covariance, each variance finite and > 0.
+Eigen::Matrix2d parse_diag(std::string_view text) {
+  const auto comma = text.find(',');
+  const double a = apps::parse_real(text.substr(0, comma), apps::Domain::kPositive);
+  const double b = comma == std::string_view::npos
+                       ? a
+                       : apps::parse_real(text.substr(comma + 1), apps::Domain::kPositive);
+  return Eigen::Vector2d(a, b).asDiagonal();
+}
+
+/// The options, or nothing when --help was printed.
+std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view a = argv[i];
-    if (a == "--help" || a == "-h") {
-      std::fputs(kUsage, stdout);
-      std::exit(0);
-    }
-    if (a == "--json") {
-      o.json = true;
-      continue;
-    }
-    if (i + 1 >= argc) throw UsageError(std::string(a) + " needs a value (or unknown option)");
-    const std::string_view v = argv[++i];
-    try {
-      if (a == "--groundtruth") o.groundtruth = std::filesystem::path(v);
-      else if (a == "--estimate") o.estimates.emplace_back(v);
-      else if (a == "--format") o.format = parse_format(v);
-      else if (a == "--times") o.times = std::filesystem::path(v);
-      else if (a == "--plane") o.plane = parse_plane(v);
-      else if (a == "--R") o.R = parse_diag(a, v);
-      else if (a == "--Q") o.Q = parse_diag(a, v);
-      else if (a == "--cv-q") o.cv_q = parse_double(a, v);
-      else if (a == "--align") o.alignment = parse_alignment(v);
-      else if (a == "--max-time-diff") o.max_time_diff = parse_double(a, v);
-      else if (a == "--method") o.method = std::string(v);
-      else if (a == "--out") o.out = std::filesystem::path(v);
-      else if (a == "--plot") o.plot = std::filesystem::path(v);
-      else throw UsageError("unknown option " + std::string(a) + " (see --help)");
-    } catch (const posefuse::invalid_argument& e) {
-      throw UsageError(std::string(a) + ": " + e.what());
-    }
-  }
+  apps::Parser cli(cmd.program,
+                   "[--groundtruth REF --estimate EST [--estimate EST2 ...]] [options]",
+                   "Filters SLAM trajectories on the road plane (seed 000) and compares the planar "
+                   "RMSE\nagainst ground truth before and after. Without files it uses a built-in "
+                   "synthetic drive.");
+  cli.path({.name = "--groundtruth", .value = "FILE", .help = "reference trajectory"},
+           o.groundtruth);
+  cli.paths({.name = "--estimate", .value = "FILE", .help = "trajectory to correct (repeat for several)"},
+            o.estimates);
+  cli.custom({.name = "--format", .value = "kitti|tum", .help = "format of all files",
+              .default_text = "kitti"},
+             [&](std::string_view v) { o.format = parse_format(v); });
+  cli.path({.name = "--times", .value = "FILE",
+            .help = "KITTI times.txt for the ground truth and KITTI estimates"},
+           o.times);
+  cli.custom({.name = "--plane", .value = "xz|xy|yz", .help = "road plane",
+              .default_text = "xz: KITTI camera frame"},
+             [&](std::string_view v) { o.plane = parse_plane(v); });
+  cli.custom({.name = "--R", .value = "VAR[,VAR]", .help = "seed's process noise R = diag",
+              .default_text = "0.01 m^2/frame"},
+             [&](std::string_view v) { o.R = parse_diag(v); });
+  cli.custom({.name = "--Q", .value = "VAR[,VAR]", .help = "seed's measurement noise Q = diag",
+              .default_text = "0.25 m^2"},
+             [&](std::string_view v) { o.Q = parse_diag(v); });
+  cli.real({.name = "--cv-q", .value = "Q", .help = "constant-velocity acceleration noise",
+            .unit = "m^2/s^3"},
+           o.cv_q, apps::Domain::kPositive);
+  cli.custom({.name = "--align", .value = "none|se3|sim3",
+              .help = "align each estimate to the ground truth first", .default_text = "none"},
+             [&](std::string_view v) { o.alignment = parse_alignment(v); });
+  cli.real({.name = "--max-time-diff", .value = "S", .help = "TUM timestamp association tolerance",
+            .unit = "s"},
+           o.max_time_diff, apps::Domain::kNonNegative);
+  cli.custom({.name = "--method", .value = "seed000|cv|cv+rts",
+              .help = "corrector whose output --out writes", .default_text = "seed000"},
+             [&](std::string_view v) {
+               if (v != "seed000" && v != "cv" && v != "cv+rts")
+                 throw apps::usage_error("expected seed000, cv or cv+rts, got '" + std::string(v) + "'");
+               o.method = std::string(v);
+             });
+  cli.path({.name = "--out", .value = "PATH",
+            .help = "write the corrected trajectory (input format); with several\n"
+                    "estimates PATH is a folder of <estimate>_<method> files"},
+           o.out);
+  cli.path({.name = "--plot", .value = "FILE.svg",
+            .help = "paths of the first estimate (truth, raw, corrected) and covariance\n"
+                    "over time (seed 000 Fig. 8)"},
+           o.plot);
+  cli.flag({.name = "--json", .help = "print the results as JSON instead of a table"}, o.json);
+  cli.epilogue("Exit status: 0 ok, 1 bad data (one line on stderr, file:line where a file is at "
+               "fault),\n2 bad usage.");
+  if (!cli.parse(cmd)) return std::nullopt;
+
   if (o.groundtruth.has_value() != !o.estimates.empty())
-    throw UsageError("give --groundtruth and at least one --estimate, or neither (synthetic data)");
-  if (o.method != "seed000" && o.method != "cv" && o.method != "cv+rts")
-    throw UsageError("--method must be seed000, cv or cv+rts");
-  if (!(o.cv_q > 0)) throw UsageError("--cv-q must be > 0");
-  if (!(o.max_time_diff >= 0)) throw UsageError("--max-time-diff must be >= 0");
+    throw apps::usage_error("give --groundtruth and at least one --estimate, or neither (synthetic data)");
+  if (o.times && o.format == Format::kTum)
+    throw apps::usage_error("--times only applies to KITTI files");
+  if (o.out && o.estimates.size() > 1) {
+    std::set<std::string> names;
+    for (const auto& e : o.estimates)
+      if (!names.insert(e.stem().string()).second)
+        throw apps::usage_error("two estimates are named '" + e.stem().string() +
+                                "'; --out would write both to one file");
+  }
   return o;
 }
 
@@ -161,7 +162,8 @@ struct MethodResult {
 };
 
 struct EstimateResult {
-  std::string name;
+  std::string name;        ///< the estimate file's stem ("synthetic" for the built-in drive)
+  std::string source;      ///< the estimate file, for error messages
   Trajectory groundtruth;  ///< associated with the estimate
   Trajectory estimate;     ///< aligned as requested
   std::vector<Eigen::Vector2d> truth_xy, raw_xy;
@@ -169,26 +171,51 @@ struct EstimateResult {
   std::vector<MethodResult> methods;
 };
 
-EstimateResult correct(std::string name, const Trajectory& gt_full, const Trajectory& est_full,
-                       const Options& o) {
+/// Throws a data error when `v` is not finite: no inf or nan reaches the output.
+void require_finite(double v, const std::string& what) {
+  if (!std::isfinite(v)) throw apps::data_error(what + " is not finite (" + apps::shortest(v) + ")");
+}
+
+void require_finite(const std::vector<Eigen::Vector2d>& points, const std::string& what) {
+  for (std::size_t k = 0; k < points.size(); ++k)
+    if (!points[k].allFinite())
+      throw apps::data_error(what + " is not finite at frame " + std::to_string(k));
+}
+
+/// A filter step that was not applied leaves a stale state: reported, not ignored.
+void require_applied(const CorrectedPoint& c, const std::string& source, const char* method,
+                     std::size_t k) {
+  if (c.status != FilterStatus::kApplied)
+    throw apps::data_error(source + ": frame " + std::to_string(k) + " (t = " + apps::shortest(c.t) +
+                           " s): the " + method + " filter step was not applied (" +
+                           to_string(c.status) + ")");
+}
+
+EstimateResult correct(std::string name, std::string source, const Trajectory& gt_full,
+                       const Trajectory& est_full, const Options& o) {
   EstimateResult r;
   r.name = std::move(name);
+  r.source = std::move(source);
   if (o.format == Format::kTum) {
     const AssociatedTrajectories a = associate(gt_full, est_full, o.max_time_diff);
     r.groundtruth = a.ref;
     r.estimate = a.est;
   } else {
     if (gt_full.size() != est_full.size())
-      throw posefuse::invalid_argument(r.name + " has " + std::to_string(est_full.size()) +
-                                       " poses but the ground truth has " +
-                                       std::to_string(gt_full.size()));
+      throw apps::data_error(r.source + " has " + std::to_string(est_full.size()) +
+                             " poses but the ground truth has " + std::to_string(gt_full.size()));
     r.groundtruth = gt_full;
     r.estimate = est_full;
   }
+  if (r.estimate.size() == 0) throw apps::data_error(r.source + " has no poses");
   r.estimate = align_trajectory(r.estimate, r.groundtruth, o.alignment).trajectory;
   r.truth_xy = project_to_plane(r.groundtruth, o.plane);
   r.raw_xy = project_to_plane(r.estimate, o.plane);
+  require_finite(r.truth_xy, r.source + ": the ground truth on the road plane");
+  require_finite(r.raw_xy, r.source + ": the estimate on the road plane" +
+                               std::string(o.alignment == Alignment::kNone ? "" : " after alignment"));
   r.rmse_before = rmse_2d(r.truth_xy, r.raw_xy);
+  require_finite(r.rmse_before, r.source + ": the planar RMSE before correction");
 
   MethodResult seed{"seed000", {}, {}, 0};
   auto seed_pipeline = make_seed000_corrector(o.plane, o.R, o.Q, Eigen::Matrix2d::Identity());
@@ -196,35 +223,51 @@ EstimateResult correct(std::string name, const Trajectory& gt_full, const Trajec
   auto cv_pipeline = make_constant_velocity_corrector(o.plane, o.cv_q, sigma);
   MethodResult cv{"cv", {}, {}, 0};
   for (std::size_t k = 0; k < r.estimate.size(); ++k) {
-    const StampedPose in{r.estimate.stamps[k], r.estimate.poses[k]};
+    const StampedPose in{r.estimate.t_s[k], r.estimate.poses[k]};
     const CorrectedPoint s = seed_pipeline(in);
+    require_applied(s, r.source, "seed000", k);
     seed.points.push_back(s.p);
     seed.variance.push_back(0.5 * s.P.trace());
     const CorrectedPoint c = cv_pipeline(in);
+    require_applied(c, r.source, "cv", k);
     cv.points.push_back(c.p);
     cv.variance.push_back(0.5 * c.P.trace());
   }
   MethodResult rts{"cv+rts", {}, {}, 0};
-  for (const auto& b : rts_smooth(cv_pipeline.stage<1>().history())) {
-    rts.points.push_back(b.mean.head<2>());
-    rts.variance.push_back(0.5 * b.cov.topLeftCorner<2, 2>().trace());
+  try {
+    for (const auto& b : rts_smooth(cv_pipeline.stage<1>().history())) {
+      rts.points.push_back(b.mean.head<2>());
+      rts.variance.push_back(0.5 * b.cov.topLeftCorner<2, 2>().trace());
+    }
+  } catch (const posefuse::invalid_argument& e) {
+    throw apps::data_error(r.source + ": cv+rts: " + e.what());
   }
   for (MethodResult* m : {&seed, &cv, &rts}) {
+    const std::string what = r.source + ": " + m->name;
+    require_finite(m->points, what + " corrected position");
+    for (std::size_t k = 0; k < m->variance.size(); ++k)
+      require_finite(m->variance[k], what + " variance at frame " + std::to_string(k));
     m->rmse = rmse_2d(r.truth_xy, m->points);
+    require_finite(m->rmse, what + " RMSE after correction");
     r.methods.push_back(std::move(*m));
   }
   return r;
 }
 
-double reduction_percent(double before, double after) {
-  return 100.0 * (before - after) / before;
+/// 100 (before - after) / before; 0 when both are 0; none when the ratio is
+/// not a finite number (after > 0 = before).
+std::optional<double> reduction_percent(double before, double after) {
+  if (before == 0) return after == 0 ? std::optional<double>(0.0) : std::nullopt;
+  const double red = 100.0 * (before - after) / before;
+  return std::isfinite(red) ? std::optional<double>(red) : std::nullopt;
 }
 
 std::string verdict(const std::string& method, double before, double after) {
-  const double red = reduction_percent(before, after);
-  if (method == "seed000" && std::abs(red) < 1e-6) return "returns its input (SPEC.md A)";
-  if (red >= 1.0) return "helps";
-  if (red > -1.0) return "no real gain";
+  const std::optional<double> red = reduction_percent(before, after);
+  if (!red) return "worse than raw";
+  if (method == "seed000" && std::abs(*red) < 1e-6) return "returns its input (SPEC.md A)";
+  if (*red >= 1.0) return "helps";
+  if (*red > -1.0) return "no real gain";
   return "worse than raw";
 }
 
@@ -235,8 +278,8 @@ std::pair<std::size_t, double> steady_state(const std::vector<double>& v) {
   return {v.size(), v.empty() ? 0.0 : v.back()};
 }
 
-void write_corrected(const std::filesystem::path& file, const EstimateResult& r,
-                     const MethodResult& m, Plane plane, Format format) {
+/// The estimate with the method's road-plane positions (height, attitude kept).
+Trajectory corrected_trajectory(const EstimateResult& r, const MethodResult& m, Plane plane) {
   Trajectory out = r.estimate;
   for (std::size_t k = 0; k < out.size(); ++k) {
     Eigen::Vector3d t = out.poses[k].translation();
@@ -248,121 +291,78 @@ void write_corrected(const std::filesystem::path& file, const EstimateResult& r,
     }
     out.poses[k].translation() = t;
   }
-  write_trajectory(file, out, format);
+  out.validate();
+  return out;
 }
 
-void write_svg(const std::filesystem::path& file, const std::vector<EstimateResult>& results) {
-  std::ofstream svg(file);
-  if (!svg) throw io_error(file, "cannot open for writing");
-  const double W = 520, H = 440, pad = 40;
-  // Left panel: paths of the first estimate. Right panel: variance over time.
-  const EstimateResult& r = results.front();
-  Eigen::Vector2d lo = r.truth_xy.front(), hi = lo;
-  for (const auto* set : {&r.truth_xy, &r.raw_xy})
-    for (const auto& p : *set) {
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
-    }
-  const double scale = std::min((W - 2 * pad) / std::max(1e-9, hi.x() - lo.x()),
-                                (H - 2 * pad) / std::max(1e-9, hi.y() - lo.y()));
-  auto path = [&](const std::vector<Eigen::Vector2d>& pts, const char* colour, double width) {
-    svg << "<polyline fill='none' stroke='" << colour << "' stroke-width='" << width
-        << "' points='";
-    for (const auto& p : pts)
-      svg << pad + (p.x() - lo.x()) * scale << ',' << H - pad - (p.y() - lo.y()) * scale << ' ';
-    svg << "'/>\n";
+/// Left: the first estimate's road-plane paths. Right: seed 000 Fig. 8, the
+/// mean position variance trace(P)/2 per frame.
+std::string plot_svg(const EstimateResult& r, Plane plane) {
+  const std::string axes(to_string(plane));
+  apps::svg::Plot paths(r.name + ": road-plane paths");
+  paths.x_axis(axes.substr(0, 1), "m").y_axis(axes.substr(1, 1), "m").equal_aspect();
+  paths.line("ground truth", r.truth_xy, {"#000000", 2.0, {}});
+  paths.line("raw estimate", r.raw_xy, {"#d62728", 1.0, {}});
+  paths.line("cv+rts", r.methods[2].points, {"#1f77b4", 1.0, {}});
+  paths.line("seed000 (= raw)", r.methods[0].points, {"#2ca02c", 0.6, "4,3"});
+
+  const auto curve = [](const std::vector<double>& v) {
+    std::vector<apps::svg::Point> p;
+    for (std::size_t k = 0; k < v.size(); ++k) p.push_back({double(k), v[k]});
+    return p;
   };
-  svg << "<svg xmlns='http://www.w3.org/2000/svg' width='" << 2 * W << "' height='" << H
-      << "' font-family='sans-serif' font-size='12'>\n<rect width='100%' height='100%' "
-         "fill='white'/>\n";
-  svg << "<text x='" << pad << "' y='14'>" << r.name << ": road-plane paths</text>\n"
-      << "<text x='" << pad << "' y='28'>black truth, red raw, blue cv+rts, green seed000</text>\n";
-  path(r.truth_xy, "black", 2.0);
-  path(r.raw_xy, "red", 1.0);
-  path(r.methods[2].points, "blue", 1.0);
-  path(r.methods[0].points, "green", 0.6);
-  // Fig. 8: mean position variance trace(P)/2 per frame.
-  const std::vector<double>& v = r.methods[0].variance;
-  const std::vector<double>& vc = r.methods[1].variance;
-  double vmax = 0;
-  for (std::size_t k = 0; k < v.size(); ++k) vmax = std::max({vmax, v[k], vc[k]});
-  auto curve = [&](const std::vector<double>& c, const char* colour) {
-    svg << "<polyline fill='none' stroke='" << colour << "' points='";
-    for (std::size_t k = 0; k < c.size(); ++k)
-      svg << W + pad + (W - 2 * pad) * double(k) / double(std::max<std::size_t>(1, c.size() - 1))
-          << ',' << H - pad - (H - 2 * pad) * c[k] / vmax << ' ';
-    svg << "'/>\n";
-  };
-  svg << "<text x='" << W + pad << "' y='14'>position variance trace(P)/2 per frame "
-      << "(seed 000 Fig. 8)</text>\n<text x='" << W + pad << "' y='28'>green seed000, blue cv; "
-      << "axis 0 to " << vmax << " m^2</text>\n";
-  svg << "<line x1='" << W + pad << "' y1='" << H - pad << "' x2='" << 2 * W - pad << "' y2='"
-      << H - pad << "' stroke='grey'/>\n";
-  curve(v, "green");
-  curve(vc, "blue");
-  svg << "</svg>\n";
-  if (!svg) throw io_error(file, "write failed");
+  apps::svg::Plot variance("position variance trace(P)/2 per frame (seed 000 Fig. 8)");
+  variance.x_axis("frame").y_axis("variance", "m^2").include({0, 0});
+  variance.line("seed000", curve(r.methods[0].variance), {"#2ca02c", 1.5, {}});
+  variance.line("cv", curve(r.methods[1].variance), {"#1f77b4", 1.0, {}});
+
+  apps::svg::Document doc(1100, 520);
+  doc.plot(paths, {0, 0, 550, 520}).plot(variance, {550, 0, 550, 520});
+  return doc.str();
 }
 
-int run(const Options& o) {
-  std::vector<EstimateResult> results;
-  if (!o.groundtruth) {
-    const sim::SyntheticDrive drive = sim::make_kitti_like_drive();
-    results.push_back(correct("synthetic", drive.groundtruth, drive.estimate, o));
-  } else {
-    const Trajectory gt = read_trajectory(*o.groundtruth, o.format,
-                                          o.format == Format::kKitti ? o.times : std::nullopt);
-    for (const auto& e : o.estimates) {
-      const Trajectory est =
-          read_trajectory(e, o.format, o.format == Format::kKitti ? o.times : std::nullopt);
-      results.push_back(correct(e.stem().string(), gt, est, o));
-    }
-  }
-
-  if (o.out) {
-    if (results.size() > 1) std::filesystem::create_directories(*o.out);
-    const std::string ext = o.format == Format::kTum ? ".tum" : ".txt";
-    for (const auto& r : results) {
-      const auto m = std::find_if(r.methods.begin(), r.methods.end(),
-                                  [&](const MethodResult& x) { return x.name == o.method; });
-      const std::filesystem::path file =
-          results.size() > 1 ? *o.out / (r.name + "_" + o.method + ext) : *o.out;
-      write_corrected(file, r, *m, o.plane, o.format);
-    }
-  }
-  if (o.plot) write_svg(*o.plot, results);
-
+void print_json(const Options& o, const std::vector<EstimateResult>& results) {
   const auto [steady_frame, steady_value] = steady_state(results.front().methods[0].variance);
-  if (o.json) {
-    std::printf("{\n  \"plane\": \"%s\",\n  \"estimates\": [\n", std::string(to_string(o.plane)).c_str());
-    for (std::size_t i = 0; i < results.size(); ++i) {
-      const auto& r = results[i];
-      std::printf("    {\"name\": \"%s\", \"frames\": %zu, \"rmse_before\": %.6f, \"methods\": [\n",
-                  r.name.c_str(), r.estimate.size(), r.rmse_before);
-      for (std::size_t j = 0; j < r.methods.size(); ++j) {
-        const auto& m = r.methods[j];
-        std::printf("      {\"method\": \"%s\", \"rmse_after\": %.6f, \"reduction_percent\": %.4f, "
-                    "\"verdict\": \"%s\"}%s\n",
-                    m.name.c_str(), m.rmse, reduction_percent(r.rmse_before, m.rmse),
-                    verdict(m.name, r.rmse_before, m.rmse).c_str(),
-                    j + 1 < r.methods.size() ? "," : "");
-      }
-      std::printf("    ]}%s\n", i + 1 < results.size() ? "," : "");
+  using Layout = apps::JsonWriter::Layout;
+  apps::JsonWriter j(std::cout);
+  j.begin_object();
+  j.member("plane", to_string(o.plane)).member("alignment", to_string(o.alignment));
+  j.key("estimates").begin_array(Layout::kBlock);
+  for (const auto& r : results) {
+    j.begin_object();
+    j.member("name", r.name).member("frames", r.estimate.size()).member("rmse_before", r.rmse_before);
+    j.key("methods").begin_array(Layout::kBlock);
+    for (const auto& m : r.methods) {
+      j.begin_object(Layout::kInline).member("method", m.name).member("rmse_after", m.rmse);
+      const std::optional<double> red = reduction_percent(r.rmse_before, m.rmse);
+      j.key("reduction_percent");
+      if (red) j.value(*red);
+      else j.null();
+      j.member("verdict", verdict(m.name, r.rmse_before, m.rmse)).end_object();
     }
-    std::printf("  ],\n  \"seed000_covariance\": {\"initial\": %.6f, \"steady\": %.6f, "
-                "\"steady_frame\": %zu}\n}\n",
-                results.front().methods[0].variance.front(), steady_value, steady_frame);
-    return 0;
+    j.end_array().end_object();
   }
+  j.end_array();
+  j.key("seed000_covariance").begin_object(Layout::kInline);
+  j.member("initial", results.front().methods[0].variance.front())
+      .member("steady", steady_value)
+      .member("steady_frame", steady_frame);
+  j.end_object().end_object().finish();
+}
+
+void print_table(const Options& o, const std::vector<EstimateResult>& results) {
+  const auto [steady_frame, steady_value] = steady_state(results.front().methods[0].variance);
   std::printf("Planar RMSE against ground truth (seed 000, Table 1), plane %s, alignment %s\n\n",
               std::string(to_string(o.plane)).c_str(), std::string(to_string(o.alignment)).c_str());
   std::printf("%-22s %-8s %16s %15s %10s   %s\n", "estimate", "method", "RMSE before [m]",
               "RMSE after [m]", "reduction", "verdict");
   for (const auto& r : results) {
     for (const auto& m : r.methods) {
-      std::printf("%-22s %-8s %16.3f %15.3f %8.2f %%   %s\n", r.name.c_str(), m.name.c_str(),
-                  r.rmse_before, m.rmse, reduction_percent(r.rmse_before, m.rmse),
-                  verdict(m.name, r.rmse_before, m.rmse).c_str());
+      const std::optional<double> red = reduction_percent(r.rmse_before, m.rmse);
+      std::printf("%-22s %-8s %16.3f %15.3f ", r.name.c_str(), m.name.c_str(), r.rmse_before, m.rmse);
+      if (red) std::printf("%8.2f %%", *red);
+      else std::printf("%10s", "n/a");
+      std::printf("   %s\n", verdict(m.name, r.rmse_before, m.rmse).c_str());
     }
   }
   std::printf("\nseed000 position variance trace(P)/2: %.4f m^2 at the first frame, steady "
@@ -370,19 +370,57 @@ int run(const Options& o) {
               results.front().methods[0].variance.front(), steady_value, steady_frame);
   std::printf("seed000 returns its input whatever R and Q (u = z_t - z_{t-1} cancels the gain; "
               "SPEC.md A).\n");
+}
+
+int run(const Options& o) {
+  // 1. Compute everything; any failure stops here, before an output exists.
+  std::vector<EstimateResult> results;
+  if (!o.groundtruth) {
+    const sim::SyntheticDrive drive = sim::make_kitti_like_drive();
+    results.push_back(correct("synthetic", "built-in synthetic drive", drive.groundtruth,
+                              drive.estimate, o));
+  } else {
+    const auto times = o.format == Format::kKitti ? o.times : std::nullopt;
+    const Trajectory gt = read_trajectory(*o.groundtruth, o.format, times);
+    for (const auto& e : o.estimates)
+      results.push_back(
+          correct(e.stem().string(), e.string(), gt, read_trajectory(e, o.format, times), o));
+  }
+
+  // 2. The output files, in memory (the SVG refuses non-finite numbers).
+  apps::OutputFiles files;
+  if (o.out) {
+    const std::string ext = o.format == Format::kTum ? ".tum" : ".txt";
+    std::vector<std::pair<std::string, Trajectory>> corrected;
+    for (const auto& r : results) {
+      const auto m = std::find_if(r.methods.begin(), r.methods.end(),
+                                  [&](const MethodResult& x) { return x.name == o.method; });
+      corrected.emplace_back(r.name + "_" + o.method + ext, corrected_trajectory(r, *m, o.plane));
+    }
+    if (results.size() == 1) {
+      files.add_with(*o.out, [t = std::move(corrected.front().second), f = o.format](
+                                 const std::filesystem::path& p) { write_trajectory(p, t, f); });
+    } else {
+      files.add_folder(*o.out, [c = std::move(corrected), f = o.format](
+                                   const std::filesystem::path& dir) {
+        for (const auto& [name, t] : c) write_trajectory(dir / name, t, f);
+      });
+    }
+  }
+  if (o.plot) files.add(*o.plot, plot_svg(results.front(), o.plane));
+
+  // 3. Write the files (all or none), then the report.
+  files.commit();
+  if (o.json) print_json(o, results);
+  else print_table(o, results);
   return 0;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return run(parse_args(argc, argv));
-  } catch (const UsageError& e) {
-    std::fprintf(stderr, "orb_trajectory_correction: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "orb_trajectory_correction: %s\n", e.what());
-    return 1;
-  }
+  return posefuse::apps::run_main(argc, argv, [](const posefuse::apps::CommandLine& cmd) {
+    const std::optional<Options> o = parse_options(cmd);
+    return o ? run(*o) : 0;
+  });
 }

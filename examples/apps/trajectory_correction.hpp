@@ -24,7 +24,7 @@
 #include <posefuse/core/pipeline.hpp>
 #include <posefuse/filters/ekf.hpp>
 #include <posefuse/filters/rts_smoother.hpp>
-#include <posefuse/io/plane.hpp>
+#include <posefuse/core/plane.hpp>
 #include <posefuse/models/constant_velocity.hpp>
 #include <posefuse/models/planar_displacement.hpp>
 #include <posefuse/models/position.hpp>
@@ -54,7 +54,9 @@ struct CorrectorStep {
 };
 
 /// A corrected road-plane position with its covariance and the status of the
-/// frame's update (a rejected update leaves the prediction in place).
+/// frame's step: the prediction's status when it was not applied (then no
+/// update was tried and `p`, `P` are the previous frame's belief), else the
+/// update's (a rejected update leaves the prediction in place).
 struct CorrectedPoint {
   double t = 0;
   Eigen::Vector2d p = Eigen::Vector2d::Zero();
@@ -154,7 +156,10 @@ class DisplacementEkf {
 using ConstantVelocityEkf = Ekf<ConstantVelocity2<double>, PositionFix<4>>;
 
 /// Stage: constant-velocity EKF on road-plane positions. Keeps a record of
-/// the run for RTS smoothing (`history()`).
+/// the run for RTS smoothing (`history()`). A frame whose prediction is not
+/// applied (e.g. its time goes backwards: kInvalidInput) is reported in the
+/// output's status and recorded as "no change" (F = I), and the next
+/// prediction starts from the time of the belief, not of that frame.
 class ConstantVelocityFilter {
  public:
   using Input = StampedPoint;
@@ -185,20 +190,26 @@ class ConstantVelocityFilter {
       var << sigma_ * sigma_, sigma_ * sigma_, 100, 100;
       ekf_.reset(x0, var.asDiagonal().toDenseMatrix());
       started_ = true;
+      t_prev_ = in.t;
       rec.predicted_mean = x0;
       rec.predicted_cov = ekf_.covariance();
     } else {
       out.status = ekf_.predict(NoControl{}, in.t - t_prev_);
       rec.predicted_mean = ekf_.state();
       rec.predicted_cov = ekf_.covariance();
-      rec.F = ekf_.last_jacobian();
       if (out.status == FilterStatus::kApplied) {
+        rec.F = ekf_.last_jacobian();
+        t_prev_ = in.t;
         const auto r = ekf_.update<0>(in.p);
         out.status = r.status;
         out.nis = r.nis;
+      } else {
+        // Not applied: the belief is still the previous one, at the previous
+        // time. Record that (F = I, predicted = filtered = unchanged) rather
+        // than the Jacobian of an earlier prediction.
+        rec.F.setIdentity();
       }
     }
-    t_prev_ = in.t;
     rec.filtered_mean = ekf_.state();
     rec.filtered_cov = ekf_.covariance();
     if (record_) history_.push_back(rec);
@@ -217,7 +228,7 @@ class ConstantVelocityFilter {
   double sigma_;
   bool record_;
   bool started_ = false;
-  double t_prev_ = 0;
+  double t_prev_ = 0;  ///< time of the current belief (s)
   std::vector<SmootherStep<Eigen::Vector4d>> history_;
 };
 

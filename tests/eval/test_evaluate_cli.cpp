@@ -1,9 +1,11 @@
-// The evaluate_trajectory example end to end: its JSON numbers equal the
-// library's, and bad input exits with 2 (usage) or 1 (data) and one line
-// on stderr. Skipped visibly when the example has not been built.
+// The evaluate_trajectory example end to end: its JSON is valid and its
+// numbers equal the library's, and bad input exits with 2 (usage) or 1
+// (data, naming file:line) and one line on stderr. Skipped visibly when the
+// example has not been built.
 #include <catch2/catch.hpp>
 
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <posefuse/eval/metrics.hpp>
@@ -15,21 +17,10 @@
 
 namespace {
 
+using posefuse::test::count_lines;
+using posefuse::test::Json;
 using posefuse::test::Run;
 using posefuse::test::run;
-
-double json_number(const std::string& json, const std::string& key) {
-  const std::string tag = "\"" + key + "\": ";
-  const std::size_t at = json.find(tag);
-  REQUIRE(at != std::string::npos);
-  return std::stod(json.substr(at + tag.size()));
-}
-
-std::size_t count_lines(const std::string& s) {
-  std::size_t n = 0;
-  for (const char c : s) n += c == '\n' ? 1 : 0;
-  return n;
-}
 
 }  // namespace
 
@@ -38,7 +29,7 @@ TEST_CASE("Evaluate CLI: JSON output equals the library and errors exit cleanly"
   posefuse::test::TempDir dir("cli");
   const posefuse::Trajectory ref = posefuse::test::make_vehicle_trajectory(400, 21, 100.0);
   posefuse::Trajectory est = posefuse::test::perturb(ref, 0.3, 0.01, 22);
-  for (double& t : est.stamps) t += 0.004;  // within the default 10 ms
+  for (double& t : est.t_s) t += 0.004;  // within the default 10 ms
   posefuse::write_tum(dir.path() / "ref.tum", ref);
   posefuse::write_tum(dir.path() / "est.tum", est);
   const std::string files = "--groundtruth '" + (dir.path() / "ref.tum").string() +
@@ -51,11 +42,22 @@ TEST_CASE("Evaluate CLI: JSON output equals the library and errors exit cleanly"
   SECTION("APE, SE(3)") {
     const Run r = run(exe, files + " --align se3 --json", dir);
     REQUIRE(r.status == 0);
+    CHECK(r.err.empty());
+    CHECK(count_lines(r.out) == 1);  // one object on one line
     const auto lib = posefuse::ape(sync.ref, sync.est, posefuse::PoseRelation::kTranslation,
                                    posefuse::Alignment::kSE3);
-    CHECK(json_number(r.out, "rmse") == lib.stats.rmse);  // printed with 17 digits
-    CHECK(json_number(r.out, "median") == lib.stats.median);
-    CHECK(json_number(r.out, "count") == 400.0);
+    const Json j = Json::parse(r.out);
+    CHECK(j["metric"].string() == "ape");
+    CHECK(j["pose_relation"].string() == "trans");
+    CHECK(j["unit"].string() == "m");
+    CHECK(j["alignment"].string() == "se3");
+    CHECK(j["rmse"].number() == lib.stats.rmse);  // round-trip digits: bit-exact
+    CHECK(j["median"].number() == lib.stats.median);
+    CHECK(j["std"].number() == lib.stats.std);
+    CHECK(j["sse"].number() == lib.stats.sse);
+    CHECK(j["scale"].number() == lib.alignment.scale);
+    CHECK(j["count"].number() == 400.0);
+    CHECK_FALSE(j.has("delta"));
   }
   SECTION("RPE angle, 10 m, table output") {
     const Run r =
@@ -63,15 +65,34 @@ TEST_CASE("Evaluate CLI: JSON output equals the library and errors exit cleanly"
     REQUIRE(r.status == 0);
     CHECK(r.out.find("RPE w.r.t. rotation angle in degrees (deg)") != std::string::npos);
     CHECK(r.out.find("rmse") != std::string::npos);
+    const Run js =
+        run(exe, files + " --metric rpe --delta 10 --delta-unit m --pose-relation angle_deg --json", dir);
+    REQUIRE(js.status == 0);
+    const Json j = Json::parse(js.out);
+    CHECK(j["metric"].string() == "rpe");
+    CHECK(j["delta"].number() == 10.0);
+    CHECK(j["delta_unit"].string() == "m");
+    CHECK(j["unit"].string() == "deg");
   }
   SECTION("usage errors exit 2 with one line") {
-    for (const std::string& args : {std::string(""), files + " --align affine",
-                                    files + " --delta 0", files + " --times x", files + " extra"}) {
+    for (const std::string& args :
+         {std::string(""), files + " --align affine", files + " --delta 0", files + " --delta 1.5",
+          files + " --delta 1e400", files + " --delta-unit km", files + " --times x",
+          files + " extra", files + " --max-time-diff -0.1", files + " --max-time-diff nan",
+          files + " --metric xyz", files + " --estimate-format csv", files + " --json=yes",
+          files + " --pose-relation", std::string("--groundtruth x --estimate y --groundtruth z")}) {
       INFO(args);
       const Run r = run(exe, args, dir);
       CHECK(r.status == 2);
       CHECK(count_lines(r.err) == 1);
+      CHECK(r.err.rfind("evaluate_trajectory: ", 0) == 0);
+      CHECK(r.err.find("(try --help)") != std::string::npos);
+      CHECK(r.out.empty());
     }
+    const Run help = run(exe, files + " --help", dir);
+    CHECK(help.status == 0);
+    CHECK(help.out.rfind("usage: evaluate_trajectory --groundtruth REF --estimate EST", 0) == 0);
+    CHECK(help.out.find("--max-time-diff S") != std::string::npos);
   }
   SECTION("data errors exit 1 and name file:line") {
     std::ofstream(dir.path() / "bad.tum") << "0 0 0 0 0 0 0 1\n0.1 0 0 0 0 0 0\n";
@@ -82,6 +103,7 @@ TEST_CASE("Evaluate CLI: JSON output equals the library and errors exit cleanly"
     CHECK(r.status == 1);
     CHECK(count_lines(r.err) == 1);
     CHECK(r.err.find("bad.tum:2: expected 8") != std::string::npos);
+    CHECK(r.out.empty());
     const Run far = run(exe, files + " --max-time-diff 0.001", dir);
     CHECK(far.status == 1);
     CHECK(far.err.find("found no matching timestamps") != std::string::npos);

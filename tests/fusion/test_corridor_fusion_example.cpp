@@ -1,5 +1,7 @@
-// The corridor_fusion example end to end: table, JSON, SVG, --write-log then
-// --log gives the same figures, and bad input exits non-zero with one line.
+// The corridor_fusion example end to end: table, JSON (valid, round-trip
+// numbers), SVG, --write-log then --log gives the same figures; usage errors
+// exit 2, bad data and unwritable outputs exit 1, each with one line, and a
+// failed run leaves no output behind.
 #include <catch2/catch.hpp>
 
 #include <filesystem>
@@ -12,6 +14,8 @@
 #include "support/temp_dir.hpp"
 
 namespace {
+
+using posefuse::test::Json;
 
 /// The text after `"key": ` following the object of `method`.
 std::string json_field(const std::string& json, const std::string& method, const std::string& key) {
@@ -59,6 +63,9 @@ TEST_CASE("corridor_fusion: prints the table, the per-turn yaw errors and an SVG
   const std::string text = posefuse::test::slurp(svg);
   CHECK(text.rfind("<svg", 0) == 0);
   CHECK(text.find("ground truth") != std::string::npos);
+  CHECK(text.find(">x (m)</text>") != std::string::npos);
+  CHECK(text.find("gated_fuser (loop closure ") != std::string::npos);
+  CHECK(text.find("nan") == std::string::npos);
   CHECK(text.find("</svg>") != std::string::npos);
 }
 
@@ -79,9 +86,26 @@ TEST_CASE("corridor_fusion: --json, and --write-log then --log gives the same fi
   }
   CHECK(std::stod(json_field(sim.out, "slam_only", "loop_closure_error")) > 1.5);
   CHECK(std::stod(json_field(sim.out, "gated_fuser", "loop_closure_error")) < 1.0);
+  // The whole document is valid JSON with the documented members.
+  const Json j = Json::parse(sim.out);
+  CHECK(j["source"].string() == "simulation, seed 3");
+  CHECK(j["turns"].number() == 4);
+  CHECK(j["turns_from_groundtruth"].boolean());
+  for (const char* m : {"slam_only", "odometry_only", "seed_fuser", "gated_fuser"}) {
+    const Json& x = j["methods"][m];
+    CHECK(x["yaw_error_after_turn_deg"].array().size() == 4);
+    CHECK(x["poses"].number() > 0);
+    CHECK(x["time_without_pose_s"].is_number());
+  }
+  CHECK(j["methods"]["gated_fuser"]["loop_closure_error"].number() ==
+        Json::parse(rec.out)["methods"]["gated_fuser"]["loop_closure_error"].number());
+  for (const char* k : {"valid", "lost", "reinit", "tilted"}) CHECK(j["slam"][k].is_number());
+  CHECK(j["gated_fuser"]["anchors"].number() >= 1);
+  CHECK(j["magnetometer_note"].is_string());
+  CHECK(j["warnings"].is_array());
 }
 
-TEST_CASE("corridor_fusion: bad input exits non-zero with a one-line reason",
+TEST_CASE("corridor_fusion: bad input exits 2 (usage) or 1 (data) with a one-line reason",
           "[fusion][examples][corridor]") {
   POSEFUSE_REQUIRE_EXAMPLE(exe, "corridor_fusion");
   posefuse::test::TempDir dir("corridor-example");
@@ -90,26 +114,50 @@ TEST_CASE("corridor_fusion: bad input exits non-zero with a one-line reason",
   std::ofstream(bad / "robot.txt") << "ticks_per_rev 1320\nwheel_radius 0.065\n";
   struct Case {
     std::string args, expect;
+    int status;
   };
   const Case cases[] = {
-      {"--frobnicate", "unknown option"},
-      {"--seed", "needs a value"},
-      {"--seed -3", "non-negative integer"},
-      {"--seed 1 --log x", "exclude each other"},
-      {"--log '" + (dir.path() / "missing").string() + "'", "log folder does not exist"},
-      {"--log '" + bad.string() + "'", "robot.txt:2: unknown key 'wheel_radius'"},
+      {"--frobnicate", "unknown option", 2},
+      {"--seed", "needs a value", 2},
+      {"--seed -3", "non-negative integer", 2},
+      {"--seed 99999999999999999999999", "out of range", 2},  // not wrapped to 2^64 - 1
+      {"--seed 1x", "non-negative integer", 2},
+      {"--seed 1 --log x", "exclude each other", 2},
+      {"--seed 1 --seed 2", "given more than once", 2},
+      {"--log x --write-log y", "cannot be used with --log", 2},
+      {"--json extra", "unexpected argument 'extra'", 2},
+      {"--log '" + (dir.path() / "missing").string() + "'", "log folder does not exist", 1},
+      {"--log '" + bad.string() + "'", "robot.txt:2: unknown key 'wheel_radius'", 1},
+      {"--svg /dev/full", "/dev/full: write failed", 1},
+      {"--svg '" + (dir.path() / "no" / "p.svg").string() + "'", "no/p.svg: cannot open", 1},
   };
   for (const auto& c : cases) {
     const auto r = posefuse::test::run(exe, c.args, dir);
     INFO(c.args << " -> " << r.err);
-    CHECK(r.status != 0);
+    CHECK(r.status == c.status);
     CHECK(r.err.find(c.expect) != std::string::npos);
+    CHECK(r.err.rfind("corridor_fusion: ", 0) == 0);
     CHECK(r.err.find('\n') == r.err.size() - 1);  // exactly one line
+    CHECK((r.err.find("(try --help)") != std::string::npos) == (c.status == 2));
     CHECK(r.out.empty());
   }
   const auto help = posefuse::test::run(exe, "--help", dir);
   CHECK(help.status == 0);
   CHECK(help.out.find("--write-log") != std::string::npos);
+  CHECK(help.out.find("--seed N") != std::string::npos);
+}
+
+TEST_CASE("corridor_fusion: a failing --svg leaves no --write-log behind",
+          "[fusion][examples][corridor]") {
+  POSEFUSE_REQUIRE_EXAMPLE(exe, "corridor_fusion");
+  posefuse::test::TempDir dir("corridor-example");
+  const auto log = dir.path() / "log";
+  const auto r = posefuse::test::run(exe, "--write-log '" + log.string() + "' --svg /dev/full", dir);
+  CHECK(r.status == 1);
+  CHECK(r.err.find("/dev/full") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(log));
+  for (const auto& f : std::filesystem::directory_iterator(dir.path()))  // no temporaries
+    CHECK(f.path().filename().string().find(".tmp.") == std::string::npos);
 }
 
 TEST_CASE("corridor_fusion: README's seed-001 table and the example's comment are its output",

@@ -1,0 +1,412 @@
+#pragma once
+/// @file
+/// The example programs' command line: declared flags, a generated `--help`,
+/// strict locale-free numbers, and one mapping of failures to exit codes.
+///
+/// A program declares its flags once, each bound to a variable:
+///
+///     Options o;
+///     apps::Parser cli("corridor_fusion", "[--seed N | --log DIR] [options]",
+///                      "Seed 001's corridor experiment.");
+///     cli.integer({.name = "--seed", .value = "N", .help = "RNG seed"}, o.seed);
+///     cli.flag({.name = "--json", .help = "print JSON"}, o.json);
+///     if (!cli.parse(cmd)) return 0;  // --help was printed
+///
+/// and its `main` is `return apps::run_main(argc, argv, body);`. Exit codes,
+/// the same in every program:
+///
+/// | code | meaning | stderr |
+/// |---|---|---|
+/// | 0 | success (also `--help`) | nothing |
+/// | 1 | bad data: io_error, a non-finite result, an output that cannot be written | one line `<program>: <file>:<line>: <reason>` (`<program>: <reason>` when no file is at fault) |
+/// | 2 | bad usage: usage_error | one line `<program>: <reason> (try --help)` |
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <concepts>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <functional>
+#include <iostream>
+#include <limits>
+#include <optional>
+#include <ostream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <system_error>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include <posefuse/core/error.hpp>
+
+namespace posefuse::apps {
+
+/// Exit status of a successful run (and of `--help`).
+inline constexpr int kExitOk = 0;
+/// Exit status when the data (input files, results, outputs) are at fault.
+inline constexpr int kExitData = 1;
+/// Exit status when the command line is at fault.
+inline constexpr int kExitUsage = 2;
+
+/// A mistake on the command line (unknown flag, missing or malformed value,
+/// flags that exclude each other); run_main exits with kExitUsage.
+class usage_error : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Data that parse but give no usable result (a non-finite figure, a filter
+/// step that was not applied); run_main exits with kExitData. Errors about a
+/// line of a file are posefuse::io_error instead.
+class data_error : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// What a real-valued flag accepts. Every domain excludes inf and NaN.
+enum class Domain {
+  kFinite,       ///< any finite number
+  kNonNegative,  ///< finite and >= 0
+  kPositive,     ///< finite and > 0 (variances, densities)
+};
+
+/// Parses all of `text` as a double: std::from_chars, so locale-free, no
+/// leading spaces or '+', no hexadecimal; "inf", "nan" and out-of-range text
+/// ("1e400") are rejected.
+/// @param[in] text   the value as typed
+/// @param[in] domain what the value must satisfy
+/// @return the number
+/// @throws usage_error naming the expectation and the text
+[[nodiscard]] inline double parse_real(std::string_view text, Domain domain = Domain::kFinite) {
+  const char* expected = domain == Domain::kPositive      ? "a finite number > 0"
+                         : domain == Domain::kNonNegative ? "a finite number >= 0"
+                                                          : "a finite number";
+  double v = 0.0;
+  const char* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, v);
+  if (ec == std::errc::result_out_of_range)
+    throw usage_error("expected " + std::string(expected) + ", got '" + std::string(text) +
+                      "' (out of the range of a double)");
+  const bool ok = ec == std::errc{} && ptr == end && std::isfinite(v) &&
+                  (domain != Domain::kPositive || v > 0.0) &&
+                  (domain != Domain::kNonNegative || v >= 0.0);
+  if (!ok) throw usage_error("expected " + std::string(expected) + ", got '" + std::string(text) + "'");
+  return v;
+}
+
+/// Parses all of `text` as a base-10 integer in [lo, hi] (std::from_chars:
+/// no sign on unsigned types, no '+', no spaces; overflow is rejected, never
+/// wrapped or clamped).
+/// @return the number
+/// @throws usage_error naming the range and the text
+template <std::integral T>
+  requires(!std::same_as<T, bool>)
+[[nodiscard]] T parse_integer(std::string_view text, T lo = std::numeric_limits<T>::min(),
+                              T hi = std::numeric_limits<T>::max()) {
+  const std::string expected =
+      lo == 0 && hi == std::numeric_limits<T>::max()
+          ? std::string("a non-negative integer")
+          : "an integer from " + std::to_string(lo) + " to " + std::to_string(hi);
+  T v{};
+  const char* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, v, 10);
+  if (ec == std::errc::result_out_of_range || (ec == std::errc{} && ptr == end && (v < lo || v > hi)))
+    throw usage_error("expected " + expected + ", got '" + std::string(text) + "' (out of range)");
+  if (ec != std::errc{} || ptr != end)
+    throw usage_error("expected " + expected + ", got '" + std::string(text) + "'");
+  return v;
+}
+
+/// Shortest text that reads back to the same double (std::to_chars; "inf"
+/// and "nan" for non-finite values). Used for defaults in `--help`.
+[[nodiscard]] inline std::string shortest(double v) {
+  char buf[64];
+  const auto [ptr, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  (void)ec;  // 64 characters always suffice for a double
+  return std::string(buf, ptr);
+}
+
+/// The command line of one run.
+struct CommandLine {
+  std::string program;            ///< file name of argv[0] ("program" when absent)
+  std::vector<std::string> args;  ///< argv[1..argc)
+
+  /// @param[in] argc, argv as given to main
+  [[nodiscard]] static CommandLine from(int argc, const char* const* argv) {
+    CommandLine c;
+    c.program = argc > 0 && argv[0] != nullptr && *argv[0] != '\0'
+                    ? std::filesystem::path(argv[0]).filename().string()
+                    : std::string("program");
+    for (int i = 1; i < argc; ++i) c.args.emplace_back(argv[i]);
+    return c;
+  }
+};
+
+/// One flag as `--help` shows it.
+struct FlagSpec {
+  std::string name{};        ///< "--seed"
+  std::string value{};       ///< the value's name in the help, "N"; empty for a switch
+  std::string help{};        ///< one line; '\n' starts an indented continuation line
+  std::string default_text{};  ///< shown as "(default ...)"; filled in from the target when empty
+  std::string unit{};        ///< appended to an automatic default ("0.01 s")
+};
+
+/// A declarative command-line parser: flags are declared with the variable
+/// they set; `parse` fills them in, `help` is generated from the declarations.
+///
+/// Rules: flags are `--name VALUE` or `--name=VALUE`; a value that starts with
+/// "--" must use the `=` form (so a forgotten value is reported, not
+/// swallowed); a flag given twice is an error unless declared repeatable;
+/// there are no positional arguments; `--help` / `-h` anywhere prints the
+/// help and nothing else is checked.
+class Parser {
+ public:
+  /// @param[in] program     name in the usage line and in error messages
+  /// @param[in] synopsis    the usage line after the program's name
+  /// @param[in] description paragraph between the usage line and the flags
+  Parser(std::string program, std::string synopsis, std::string description)
+      : program_(std::move(program)), synopsis_(std::move(synopsis)),
+        description_(std::move(description)) {}
+
+  /// Text printed after the flags (exit codes, notes).
+  Parser& epilogue(std::string text) {
+    epilogue_ = std::move(text);
+    return *this;
+  }
+
+  /// A switch: `target` becomes true when the flag is given.
+  Parser& flag(FlagSpec spec, bool& target) {
+    spec.value.clear();
+    return add(std::move(spec), false, [&target](std::string_view) { target = true; });
+  }
+
+  /// A string value.
+  Parser& text(FlagSpec spec, std::string& target) {
+    if (spec.default_text.empty() && !target.empty()) spec.default_text = target;
+    return add(std::move(spec), false, [&target](std::string_view v) { target = std::string(v); });
+  }
+
+  /// A path, absent unless given.
+  Parser& path(FlagSpec spec, std::optional<std::filesystem::path>& target) {
+    return add(std::move(spec), false, [&target](std::string_view v) {
+      if (v.empty()) throw usage_error("expected a path, got ''");
+      target = std::filesystem::path(v);
+    });
+  }
+
+  /// A repeatable path: every occurrence is appended, in order.
+  Parser& paths(FlagSpec spec, std::vector<std::filesystem::path>& target) {
+    return add(std::move(spec), true, [&target](std::string_view v) {
+      if (v.empty()) throw usage_error("expected a path, got ''");
+      target.emplace_back(v);
+    });
+  }
+
+  /// A real number in `domain` (see parse_real).
+  Parser& real(FlagSpec spec, double& target, Domain domain = Domain::kFinite) {
+    if (spec.default_text.empty())
+      spec.default_text = shortest(target) + (spec.unit.empty() ? "" : " " + spec.unit);
+    return add(std::move(spec), false,
+               [&target, domain](std::string_view v) { target = parse_real(v, domain); });
+  }
+
+  /// An integer in [lo, hi], absent unless given (see parse_integer).
+  template <std::integral T>
+    requires(!std::same_as<T, bool>)
+  Parser& integer(FlagSpec spec, std::optional<T>& target, T lo = std::numeric_limits<T>::min(),
+                  T hi = std::numeric_limits<T>::max()) {
+    return add(std::move(spec), false,
+               [&target, lo, hi](std::string_view v) { target = parse_integer<T>(v, lo, hi); });
+  }
+
+  /// An integer in [lo, hi] with the target's value as default.
+  template <std::integral T>
+    requires(!std::same_as<T, bool>)
+  Parser& integer(FlagSpec spec, T& target, T lo = std::numeric_limits<T>::min(),
+                  T hi = std::numeric_limits<T>::max()) {
+    if (spec.default_text.empty())
+      spec.default_text = std::to_string(target) + (spec.unit.empty() ? "" : " " + spec.unit);
+    return add(std::move(spec), false,
+               [&target, lo, hi](std::string_view v) { target = parse_integer<T>(v, lo, hi); });
+  }
+
+  /// A value converted by `apply` (enumerations, lists). `apply` reports a bad
+  /// value by throwing usage_error or (std/posefuse) invalid_argument; either
+  /// becomes a usage_error naming the flag.
+  Parser& custom(FlagSpec spec, std::function<void(std::string_view)> apply) {
+    return add(std::move(spec), false, std::move(apply));
+  }
+
+  /// Parses `cmd.args`, setting the declared targets.
+  /// @param[in]  cmd      the command line
+  /// @param[out] help_out where `--help` prints the help
+  /// @return false when `--help` was printed (the program should exit 0)
+  /// @throws usage_error for an unknown flag, a missing or bad value, a
+  ///         repeated flag or a positional argument
+  [[nodiscard]] bool parse(const CommandLine& cmd, std::ostream& help_out = std::cout) {
+    for (const std::string& a : cmd.args) {
+      if (a == "--help" || a == "-h") {
+        help_out << help();
+        help_out.flush();
+        return false;
+      }
+    }
+    for (Flag& f : flags_) f.count = 0;
+    for (std::size_t i = 0; i < cmd.args.size(); ++i) {
+      const std::string_view arg = cmd.args[i];
+      if (arg.substr(0, 2) != "--" || arg.size() == 2)
+        throw usage_error("unexpected argument '" + std::string(arg) + "'");
+      const std::size_t eq = arg.find('=');
+      const std::string_view name = arg.substr(0, eq);
+      Flag* f = find(name);
+      if (f == nullptr) throw usage_error("unknown option '" + std::string(name) + "'");
+      std::string_view value;
+      if (f->spec.value.empty()) {
+        if (eq != std::string_view::npos)
+          throw usage_error(std::string(name) + " takes no value");
+      } else if (eq != std::string_view::npos) {
+        value = arg.substr(eq + 1);
+      } else {
+        if (i + 1 >= cmd.args.size() || cmd.args[i + 1].rfind("--", 0) == 0)
+          throw usage_error(std::string(name) + " needs a value (" + f->spec.value + ")");
+        value = cmd.args[++i];
+      }
+      if (++f->count > 1 && !f->repeatable)
+        throw usage_error(std::string(name) + " is given more than once");
+      try {
+        f->apply(value);
+      } catch (const usage_error& e) {
+        throw usage_error(std::string(name) + ": " + e.what());
+      } catch (const std::invalid_argument& e) {  // also posefuse::invalid_argument
+        throw usage_error(std::string(name) + ": " + e.what());
+      }
+    }
+    return true;
+  }
+
+  /// True when the last parse saw flag `name`.
+  [[nodiscard]] bool given(std::string_view name) const {
+    for (const Flag& f : flags_)
+      if (f.spec.name == name) return f.count > 0;
+    return false;
+  }
+
+  /// The `--help` text, generated from the declarations.
+  [[nodiscard]] std::string help() const {
+    std::ostringstream h;
+    h << "usage: " << program_ << (synopsis_.empty() ? "" : " ") << synopsis_ << "\n";
+    if (!description_.empty()) h << "\n" << description_ << "\n";
+    std::vector<std::string> heads;
+    std::size_t width = 0;
+    for (const Flag& f : flags_) {
+      heads.push_back(f.spec.name + (f.spec.value.empty() ? "" : " " + f.spec.value));
+      width = std::max(width, heads.back().size());
+    }
+    heads.emplace_back("--help");
+    width = std::min<std::size_t>(std::max(width, heads.back().size()), 28);
+    h << "\n";
+    const auto row = [&](const std::string& head, const std::string& text) {
+      h << "  " << head;
+      if (head.size() > width) h << "\n" << std::string(width + 4, ' ');  // a long head: own line
+      else h << std::string(width + 2 - head.size(), ' ');
+      for (const char c : text) {
+        h << c;
+        if (c == '\n') h << std::string(width + 4, ' ');
+      }
+      h << "\n";
+    };
+    for (std::size_t k = 0; k < flags_.size(); ++k) {
+      const FlagSpec& s = flags_[k].spec;
+      row(heads[k], s.help + (s.default_text.empty() ? "" : " (default " + s.default_text + ")"));
+    }
+    row("--help", "print this help and exit");
+    if (!epilogue_.empty()) h << "\n" << epilogue_ << "\n";
+    return h.str();
+  }
+
+  /// The program's name given to the constructor.
+  [[nodiscard]] const std::string& program() const noexcept { return program_; }
+
+ private:
+  struct Flag {
+    FlagSpec spec;
+    bool repeatable = false;
+    std::function<void(std::string_view)> apply;
+    int count = 0;
+  };
+
+  Parser& add(FlagSpec spec, bool repeatable, std::function<void(std::string_view)> apply) {
+    if (spec.name.size() < 3 || spec.name.rfind("--", 0) != 0 || spec.name == "--help" ||
+        spec.name.find('=') != std::string::npos || find(spec.name) != nullptr)
+      throw std::logic_error("Parser: bad or duplicate flag name '" + spec.name + "'");
+    flags_.push_back({std::move(spec), repeatable, std::move(apply), 0});
+    return *this;
+  }
+
+  Flag* find(std::string_view name) {
+    for (Flag& f : flags_)
+      if (f.spec.name == name) return &f;
+    return nullptr;
+  }
+
+  std::string program_, synopsis_, description_, epilogue_;
+  std::vector<Flag> flags_;
+};
+
+/// One line for stderr: `what` with line breaks turned into spaces.
+[[nodiscard]] inline std::string one_line(std::string_view what) {
+  std::string s(what);
+  for (char& c : s)
+    if (c == '\n' || c == '\r') c = ' ';
+  return s;
+}
+
+/// Runs a program's body and maps its outcome to the exit code (table in the
+/// file comment): usage_error -> 2, any other exception (io_error naming
+/// file:line, data_error, invalid_argument, filesystem_error, bad_alloc) -> 1,
+/// each with one line on stderr. A body that returns normally but whose
+/// standard output could not be written (`> /dev/full`) also exits 1.
+/// @param[in] argc, argv as given to main
+/// @param[in] body `int(const CommandLine&)` or `void(const CommandLine&)`;
+///            an int it returns is the exit code
+/// @return the exit code
+template <class Body>
+  requires std::invocable<Body&, const CommandLine&>
+[[nodiscard]] int run_main(int argc, const char* const* argv, Body&& body) noexcept {
+  std::string program = "program";
+  const auto report = [&program](std::string_view reason) {
+    std::fprintf(stderr, "%s: %s\n", program.c_str(), one_line(reason).c_str());
+  };
+  int code = kExitOk;
+  try {
+    const CommandLine cmd = CommandLine::from(argc, argv);
+    program = cmd.program;
+    if constexpr (std::is_void_v<std::invoke_result_t<Body&, const CommandLine&>>) {
+      body(cmd);
+    } else {
+      code = static_cast<int>(body(cmd));
+    }
+  } catch (const usage_error& e) {
+    report(std::string(e.what()) + " (try --help)");
+    return kExitUsage;
+  } catch (const std::exception& e) {  // io_error's what() is "<file>:<line>: <reason>"
+    report(e.what());
+    return kExitData;
+  } catch (...) {
+    report("unknown error");
+    return kExitData;
+  }
+  std::cout.flush();
+  if (std::fflush(stdout) != 0 || std::ferror(stdout) != 0 || !std::cout) {
+    report("cannot write to standard output");
+    return kExitData;
+  }
+  return code;
+}
+
+}  // namespace posefuse::apps
