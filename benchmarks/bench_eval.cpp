@@ -40,7 +40,7 @@ Pair make_pair(std::size_t n) {
 void BM_Association_Associate(benchmark::State& state) {
   const Pair p = make_pair(static_cast<std::size_t>(state.range(0)));
   for (auto _ : state) {
-    benchmark::DoNotOptimize(posefuse::associate(p.ref.stamps, p.est.stamps));
+    benchmark::DoNotOptimize(posefuse::associate(p.ref.t_s, p.est.t_s));
   }
 }
 BENCHMARK(BM_Association_Associate)->Arg(1101)->Arg(30000);

@@ -6,10 +6,10 @@
 
 #include <array>
 #include <cmath>
-#include <posefuse/fusion/corridor_runner.hpp>
+#include <apps/corridor_runner.hpp>
 #include <posefuse/fusion/gated_fuser.hpp>
 #include <posefuse/fusion/threshold_fuser.hpp>
-#include <posefuse/sim/corridor.hpp>
+#include <apps/sim/corridor.hpp>
 
 namespace {
 

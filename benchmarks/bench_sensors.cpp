@@ -8,7 +8,8 @@
 
 #include <array>
 #include <cmath>
-#include <posefuse/core/rotation.hpp>
+#include <cstdint>
+#include <posefuse/lie/rotation.hpp>
 #include <posefuse/filters/complementary.hpp>
 #include <posefuse/models/unicycle.hpp>
 #include <posefuse/sensors/compass.hpp>
@@ -155,9 +156,9 @@ void BM_AttitudePipeline_Run(benchmark::State& state) {
   auto imu = make_imu();
   posefuse::AttitudePipeline att = posefuse::make_attitude_pipeline();
   std::size_t k = 0;
-  double t = 0.0;
+  std::int64_t t_ns = 0;
   for (auto _ : state) {
-    imu[k].t_s = (t += 0.01);
+    imu[k].t_ns = (t_ns += 10'000'000);  // 100 Hz
     benchmark::DoNotOptimize(att(imu[k]));
     k = (k + 1) % kN;
   }
@@ -170,9 +171,9 @@ void BM_AttitudeStages_ByHand(benchmark::State& state) {
   posefuse::ComplementaryTiltStage s2(0.98);
   posefuse::CompassStage s3;
   std::size_t k = 0;
-  double t = 0.0;
+  std::int64_t t_ns = 0;
   for (auto _ : state) {
-    imu[k].t_s = (t += 0.01);
+    imu[k].t_ns = (t_ns += 10'000'000);  // 100 Hz
     benchmark::DoNotOptimize(s3(s2(s1(imu[k]))));
     k = (k + 1) % kN;
   }
@@ -183,8 +184,8 @@ constexpr posefuse::DiffDriveParams kParams{1000.0, 0.05, 0.40};
 
 /// The next encoder sample of a gently curving drive at 50 Hz (the same input
 /// for the pipeline and the hand-called stages).
-void advance_wheels(posefuse::StampedWheelTicks& in, std::int64_t k) {
-  in.t_s += 0.02;
+void advance_wheels(posefuse::WheelSample& in, std::int64_t k) {
+  in.t_ns += 20'000'000;
   in.ticks.fl += 100 + (k & 7);
   in.ticks.bl += 101;
   in.ticks.fr += 120 - (k & 3);
@@ -193,7 +194,7 @@ void advance_wheels(posefuse::StampedWheelTicks& in, std::int64_t k) {
 
 void BM_OdometryPipeline_Run(benchmark::State& state) {
   posefuse::OdometryPipeline odo = posefuse::make_odometry_pipeline(kParams, {0.3, 0.01});
-  posefuse::StampedWheelTicks in{};
+  posefuse::WheelSample in{};
   std::int64_t k = 0;
   for (auto _ : state) {
     advance_wheels(in, k++);
@@ -206,7 +207,7 @@ void BM_OdometryStages_ByHand(benchmark::State& state) {
   posefuse::FourWheelAverage s1;
   posefuse::DiffDriveOdometry s2(kParams, {0.3, 0.01});
   posefuse::DeadReckoning s3;
-  posefuse::StampedWheelTicks in{};
+  posefuse::WheelSample in{};
   std::int64_t k = 0;
   for (auto _ : state) {
     advance_wheels(in, k++);

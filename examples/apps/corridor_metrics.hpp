@@ -4,11 +4,15 @@
 /// the return to the start, RMSE against ground truth, time without a valid
 /// pose, and the yaw error after each 90° turn (the seed reports about 1.9°).
 ///
-/// A *track* is the sequence of poses a method reported, in time order, in
-/// the world (= odometry) frame; times are seconds since the log's first
-/// sample. Ground truth is interpolated at the method's times (linear in
-/// position, along the shorter arc in yaw); the method's pose at a given time
-/// is the last one it had reported by then (what a user would have seen).
+/// A *track* is the PlanarTrajectory (core/trajectory.hpp) of poses a method
+/// reported, in time order, in the world (= odometry) frame; times are
+/// seconds since the log's first sample. The generic figures come from the
+/// library (eval/planar_metrics.hpp: planar_errors, loop_closure_error,
+/// time_without_pose; ground truth interpolated at the method's times,
+/// linear in position, along the shorter arc in yaw). What is particular to
+/// the seed's experiment stays here: the turns of the drive and the yaw error
+/// after each, taken from the last pose the method had reported by then
+/// (what a user would have seen).
 
 #include <algorithm>
 #include <cmath>
@@ -17,19 +21,14 @@
 #include <optional>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include <posefuse/core/angles.hpp>
-#include <posefuse/models/planar_pose.hpp>
+#include <posefuse/core/interpolation.hpp>
+#include <posefuse/core/trajectory.hpp>
+#include <posefuse/eval/planar_metrics.hpp>
 
 namespace posefuse {
-
-/// A planar pose at a time (s since the log's first sample).
-struct StampedPlanarPose {
-  double t_s{0};              ///< time (s)
-  PlanarPose<double> pose;    ///< x, y (m), theta (rad), world frame
-};
-
-/// Poses in time order.
-using PlanarTrack = std::vector<StampedPlanarPose>;
 
 /// One in-place or arc turn found in a reference track.
 struct TurnEvent {
@@ -50,29 +49,17 @@ struct CorridorMetrics {
 };
 
 /// The last pose reported at or before `t`, if it is at most `max_age_s` old.
-[[nodiscard]] inline std::optional<PlanarPose<double>> pose_at_or_before(const PlanarTrack& track,
-                                                                         double t, double max_age_s) {
-  const auto it = std::upper_bound(track.begin(), track.end(), t,
-                                   [](double v, const StampedPlanarPose& p) { return v < p.t_s; });
-  if (it == track.begin()) return std::nullopt;
-  const auto& p = *(it - 1);
-  if (t - p.t_s > max_age_s) return std::nullopt;
-  return p.pose;
-}
-
-/// The track interpolated at `t` (linear in x, y; shorter arc in theta);
-/// nullopt outside its time span.
-[[nodiscard]] inline std::optional<PlanarPose<double>> interpolate_track(const PlanarTrack& track,
-                                                                        double t) {
-  if (track.empty() || t < track.front().t_s || t > track.back().t_s) return std::nullopt;
-  const auto it = std::lower_bound(track.begin(), track.end(), t,
-                                   [](const StampedPlanarPose& p, double v) { return p.t_s < v; });
-  if (it == track.begin()) return it->pose;
-  const auto& a = *(it - 1);
-  const auto& b = *it;
-  const double f = (t - a.t_s) / (b.t_s - a.t_s);
-  return PlanarPose<double>{a.pose.x + f * (b.pose.x - a.pose.x), a.pose.y + f * (b.pose.y - a.pose.y),
-                            angle_interpolate(a.pose.theta, b.pose.theta, f)};
+/// @param[in] track poses in time order
+/// @param[in] t time (s)
+/// @param[in] max_age_s the oldest pose still returned (s)
+/// @return (x m, y m, θ rad), or nullopt
+[[nodiscard]] inline std::optional<Eigen::Vector3d> pose_at_or_before(const PlanarTrajectory& track,
+                                                                    double t, double max_age_s) {
+  const auto it = std::upper_bound(track.t_s.begin(), track.t_s.end(), t);
+  if (it == track.t_s.begin()) return std::nullopt;
+  const auto k = std::size_t(it - track.t_s.begin()) - 1;
+  if (t - track.t_s[k] > max_age_s) return std::nullopt;
+  return track.poses[k];
 }
 
 /// Finds turns in a smooth reference track (ground truth, or encoder dead
@@ -80,7 +67,7 @@ struct CorridorMetrics {
 /// over windows of at least 0.1 s), joined when less than `join_s` apart,
 /// kept when the net heading change exceeds `min_angle_rad`.
 /// @return the turns in time order
-[[nodiscard]] inline std::vector<TurnEvent> detect_turns(const PlanarTrack& ref,
+[[nodiscard]] inline std::vector<TurnEvent> detect_turns(const PlanarTrajectory& ref,
                                                          double rate_threshold = 0.1,
                                                          double join_s = 1.0,
                                                          double min_angle_rad = std::numbers::pi / 4) {
@@ -88,17 +75,18 @@ struct CorridorMetrics {
   std::optional<TurnEvent> cur;
   double angle = 0;
   std::size_t j = 0;
+  const std::vector<double>& t = ref.t_s;
   for (std::size_t i = 1; i < ref.size(); ++i) {
-    if (ref[i].t_s - ref[j].t_s < 0.1) continue;
-    const double d = angle_diff(ref[i].pose.theta, ref[j].pose.theta);
-    const bool turning = std::abs(d) / (ref[i].t_s - ref[j].t_s) > rate_threshold;
+    if (t[i] - t[j] < 0.1) continue;
+    const double d = angle_diff(ref.heading(i), ref.heading(j));
+    const bool turning = std::abs(d) / (t[i] - t[j]) > rate_threshold;
     if (turning) {
-      if (cur && ref[j].t_s - cur->t_end_s <= join_s) {
-        cur->t_end_s = ref[i].t_s;
+      if (cur && t[j] - cur->t_end_s <= join_s) {
+        cur->t_end_s = t[i];
         angle += d;
       } else {
         if (cur && std::abs(angle) >= min_angle_rad) turns.push_back({cur->t_start_s, cur->t_end_s, angle});
-        cur = TurnEvent{ref[j].t_s, ref[i].t_s, 0};
+        cur = TurnEvent{t[j], t[i], 0};
         angle = d;
       }
       cur->angle_rad = angle;
@@ -111,54 +99,47 @@ struct CorridorMetrics {
 
 /// Evaluates one method's track.
 ///
-/// * loop-closure error: distance from the last reported position to `start`;
-/// * RMSE: over the poses inside the ground truth's time span;
+/// * loop-closure error: distance from the last reported position to `start`
+///   (loop_closure_error; NaN without a pose);
+/// * RMSE and `max_yaw_error_all_deg`: over the poses inside the ground
+///   truth's time span (planar_errors; NaN without ground truth or overlap);
 /// * time without a valid pose: the summed length of the gaps longer than
 ///   `gap_s` between consecutive poses, counting from `t_begin` to the first
-///   pose and from the last pose to `t_end`;
+///   pose and from the last pose to `t_end` (time_without_pose);
 /// * yaw error after each turn, at `t_end_s + settle_s`, of the last pose
 ///   reported by then (NaN if it is older than `gap_s`): against ground
 ///   truth when given, else against the nominal heading (0 plus the sum of
 ///   the turns' angles rounded to multiples of 90°, i.e. square corners);
 /// * max yaw error (`max_yaw_error_deg`): the largest |after-turn error|,
 ///   with or without ground truth (the figure the seed reports as about
-///   1.9°); NaN when no turn has a pose;
-/// * `max_yaw_error_all_deg`: the largest yaw error over every pose against
-///   ground truth (NaN without ground truth).
+///   1.9°); NaN when no turn has a pose.
 /// @param[in] track       the method's poses, time order
 /// @param[in] groundtruth ground truth (may be empty)
 /// @param[in] turns       turns to evaluate (detect_turns)
-/// @param[in] start       the start position (world frame)
-[[nodiscard]] inline CorridorMetrics evaluate_track(const PlanarTrack& track,
-                                                    const PlanarTrack& groundtruth,
+/// @param[in] start       the start position (world frame, m)
+/// @param[in] t_begin, t_end the evaluated span (s)
+/// @param[in] gap_s       longest gap that still counts as having a pose (s)
+/// @param[in] settle_s    delay after a turn's end at which its yaw is taken (s)
+/// @throws posefuse::invalid_argument for a track or ground truth with
+///         non-finite entries or decreasing stamps (eval/planar_metrics.hpp)
+[[nodiscard]] inline CorridorMetrics evaluate_track(const PlanarTrajectory& track,
+                                                    const PlanarTrajectory& groundtruth,
                                                     const std::vector<TurnEvent>& turns,
-                                                    const PlanarPose<double>& start, double t_begin,
+                                                    const Eigen::Vector2d& start, double t_begin,
                                                     double t_end, double gap_s = 0.5,
                                                     double settle_s = 0.25) {
   constexpr double kDeg = 180.0 / std::numbers::pi;
   CorridorMetrics m;
   m.poses = track.size();
-  if (!track.empty())
-    m.loop_closure_error_m = std::hypot(track.back().pose.x - start.x, track.back().pose.y - start.y);
-  double prev = t_begin;
-  for (const auto& p : track) {
-    if (p.t_s - prev > gap_s) m.time_without_pose_s += p.t_s - prev;
-    prev = std::max(prev, p.t_s);
-  }
-  if (t_end - prev > gap_s) m.time_without_pose_s += t_end - prev;
+  if (!track.empty()) m.loop_closure_error_m = loop_closure_error(track, start);
+  m.time_without_pose_s = time_without_pose(track, t_begin, t_end, gap_s);
   const bool have_gt = !groundtruth.empty();
-  double se = 0, max_yaw = 0;
-  std::size_t n = 0;
-  for (const auto& p : track) {
-    const auto g = have_gt ? interpolate_track(groundtruth, p.t_s) : std::nullopt;
-    if (!g) continue;
-    se += (p.pose.x - g->x) * (p.pose.x - g->x) + (p.pose.y - g->y) * (p.pose.y - g->y);
-    max_yaw = std::max(max_yaw, std::abs(angle_diff(p.pose.theta, g->theta)) * kDeg);
-    ++n;
-  }
-  if (n > 0) {
-    m.rmse_m = std::sqrt(se / double(n));
-    m.max_yaw_error_all_deg = max_yaw;
+  if (have_gt) {
+    const PlanarErrors e = planar_errors(track, groundtruth);
+    if (e.matched > 0) {
+      m.rmse_m = e.rmse_m;
+      m.max_yaw_error_all_deg = e.max_heading_error_rad * kDeg;
+    }
   }
   double nominal = 0;
   double max_turn = 0;
@@ -167,9 +148,9 @@ struct CorridorMetrics {
     nominal += std::round(turn.angle_rad / (std::numbers::pi / 2)) * (std::numbers::pi / 2);
     const double t = turn.t_end_s + settle_s;
     const auto est = pose_at_or_before(track, t, gap_s);
-    const auto g = have_gt ? interpolate_track(groundtruth, t) : std::nullopt;
+    const auto g = have_gt ? interpolate_at(groundtruth, t) : std::nullopt;
     double err = std::numeric_limits<double>::quiet_NaN();
-    if (est && (g || !have_gt)) err = angle_diff(est->theta, g ? g->theta : wrap_angle(nominal)) * kDeg;
+    if (est && (g || !have_gt)) err = angle_diff((*est)(2), g ? (*g)(2) : wrap_angle(nominal)) * kDeg;
     m.yaw_error_after_turn_deg.push_back(err);
     if (std::isfinite(err)) {
       max_turn = std::max(max_turn, std::abs(err));

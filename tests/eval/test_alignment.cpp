@@ -103,7 +103,7 @@ TEST_CASE("Alignment: applied as evo does, scale positions then left-multiply",
   CHECK(moved.poses[0].linear().isApprox(a.rotation * P.linear(), 1e-15));
   CHECK(moved.poses[0].translation().isApprox(a.rotation * (2.0 * P.translation()) + a.translation,
                                               1e-15));
-  CHECK(moved.stamps == traj.stamps);
+  CHECK(moved.t_s == traj.t_s);
 }
 
 TEST_CASE("Alignment: align_trajectory undoes a Sim(3) on a synthetic drive", "[eval][alignment]") {
@@ -131,7 +131,7 @@ TEST_CASE("Alignment: align_trajectory undoes a Sim(3) on a synthetic drive", "[
   CHECK(none.trajectory.poses[7].matrix() == est.poses[7].matrix());
   posefuse::Trajectory shorter = est;
   shorter.poses.pop_back();
-  shorter.stamps.pop_back();
+  shorter.t_s.pop_back();
   CHECK_THROWS_WITH(posefuse::align_trajectory(shorter, ref, posefuse::Alignment::kSE3),
                     Catch::Contains("associate them first"));
 }

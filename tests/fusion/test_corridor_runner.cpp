@@ -4,14 +4,17 @@
 
 #include <atomic>
 #include <chrono>
+#include <cstdint>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <numbers>
+#include <utility>
 #include <unistd.h>
-#include <posefuse/fusion/corridor_runner.hpp>
+#include <apps/corridor_runner.hpp>
 #include <posefuse/io/robot_log.hpp>
-#include <posefuse/sim/corridor.hpp>
+#include <apps/sim/corridor.hpp>
 
 namespace fs = std::filesystem;
 using posefuse::CorridorMethod;
@@ -139,11 +142,12 @@ TEST_CASE("Corridor: other rates and phases, a SLAM map that is not the world fr
   for (auto& s : sim.log.slam) {
     if (s.state == posefuse::SlamState::kReinit) break;
     if (s.state == posefuse::SlamState::kLost) continue;
-    const double yaw = 2 * std::atan2(s.q[2], s.q[3]);
-    const auto p = posefuse::se2_compose(T_m0w, posefuse::PlanarPose<double>{s.p[0], s.p[1], yaw});
-    s.p[0] = p.x;
-    s.p[1] = p.y;
-    s.q = {0, 0, std::sin(p.theta / 2), std::cos(p.theta / 2)};
+    const double yaw = 2 * std::atan2(s.orientation.z(), s.orientation.w());
+    const auto p = posefuse::se2_compose(
+        T_m0w, posefuse::PlanarPose<double>{s.position_m.x(), s.position_m.y(), yaw});
+    s.position_m.x() = p.x;
+    s.position_m.y() = p.y;
+    s.orientation.coeffs() << 0, 0, std::sin(p.theta / 2), std::cos(p.theta / 2);
   }
   const auto r = posefuse::run_corridor(sim.log);
   const auto& m = r.metrics;
@@ -181,10 +185,10 @@ TEST_CASE("Corridor: a log whose SLAM never tracks runs on odometry alone", "[fu
   CHECK(r.metrics[kSlam].time_without_pose_s == Approx(r.duration_s));
   CHECK(r.gated_anchors == 0);
   // The gated fuser then is dead reckoning, the seed fuser is O_m.
-  const auto& g = r.tracks[kGated].back().pose;
-  const auto& d = r.dead_reckoning.back().pose;
-  CHECK(g.x == Approx(d.x).margin(1e-9));
-  CHECK(g.y == Approx(d.y).margin(1e-9));
+  const Eigen::Vector3d& g = r.tracks[kGated].poses.back();
+  const Eigen::Vector3d& d = r.dead_reckoning.poses.back();
+  CHECK(g.x() == Approx(d.x()).margin(1e-9));
+  CHECK(g.y() == Approx(d.y()).margin(1e-9));
   CHECK(r.metrics[kSeed].loop_closure_error_m == r.metrics[kOdom].loop_closure_error_m);
 }
 
@@ -195,9 +199,10 @@ TEST_CASE("Corridor: camera-frame SLAM poses are a clear error naming slam.csv",
   // orientations rotated by +90 deg about x (the body's z axis is horizontal).
   const double h = std::sqrt(0.5);
   for (auto& s : sim.log.slam) {
-    const auto [x, y, z, w] = s.q;
-    s.q = {h * (w + x), h * (y + z), h * (z - y), h * (w - x)};  // q * (h, 0, 0, h): about x
-    s.p = {-s.p[1], -s.p[2], s.p[0]};
+    const double x = s.orientation.x(), y = s.orientation.y(), z = s.orientation.z(),
+                 w = s.orientation.w();
+    s.orientation.coeffs() << h * (w + x), h * (y + z), h * (z - y), h * (w - x);  // q * (h, 0, 0, h): about x
+    s.position_m = Eigen::Vector3d(-s.position_m.y(), -s.position_m.z(), s.position_m.x());
   }
   int valid = 0;
   for (const auto& s : sim.log.slam) valid += s.state != posefuse::SlamState::kLost;
@@ -220,8 +225,9 @@ TEST_CASE("Corridor: a minority of tilted SLAM poses runs, counted and warned ab
   int tilted = 0, k = 0;
   for (auto& s : sim.log.slam) {
     if (s.state == posefuse::SlamState::kLost || k++ % 10 != 0) continue;
-    const auto [x, y, z, w] = s.q;
-    s.q = {h * (w + x), h * (y + z), h * (z - y), h * (w - x)};
+    const double x = s.orientation.x(), y = s.orientation.y(), z = s.orientation.z(),
+                 w = s.orientation.w();
+    s.orientation.coeffs() << h * (w + x), h * (y + z), h * (z - y), h * (w - x);
     ++tilted;
   }
   const auto r = posefuse::run_corridor(sim.log);
@@ -267,26 +273,27 @@ TEST_CASE("Corridor: a hand-written log folder with interleaved stamps is proces
   CHECK(r.magnetometer_note.rfind("not calibrated", 0) == 0);  // it never turned
   CHECK(r.turns.empty());
   int at_slam = 0;
-  for (const auto& p : r.tracks[kSeed]) {
+  const posefuse::PlanarTrajectory& seed = r.tracks[kSeed];
+  for (std::size_t k = 0; k < seed.size(); ++k) {
     // t = 0 is the first stamp of any stream: the wheels' 3 ms.
-    const double phase = std::fmod(p.t_s - 0.030, 1.0 / 15.0);
+    const double t = seed.t_s[k];
+    const double phase = std::fmod(t - 0.030, 1.0 / 15.0);
     const bool slam_time = std::abs(phase) < 1e-6 || std::abs(phase - 1.0 / 15.0) < 1e-6;
-    if (!slam_time || p.t_s < 0.05) continue;
+    if (!slam_time || t < 0.05) continue;
     ++at_slam;
-    CHECK(std::abs(p.pose.x - 0.2 * (p.t_s + 0.003)) < 1e-3);
+    CHECK(std::abs(seed.poses[k].x() - 0.2 * (t + 0.003)) < 1e-3);
   }
   CHECK(at_slam > 60);
-  const auto& g = r.tracks[kGated].back();
-  CHECK(g.pose.x == Approx(0.2 * (g.t_s + 0.003)).margin(0.01));
-  CHECK(std::abs(g.pose.y) < 0.01);
+  const posefuse::PlanarTrajectory& gated = r.tracks[kGated];
+  CHECK(gated.poses.back().x() == Approx(0.2 * (gated.t_s.back() + 0.003)).margin(0.01));
+  CHECK(std::abs(gated.poses.back().y()) < 0.01);
 }
 
 TEST_CASE("Corridor: a SLAM map that never matches odometry is warned about",
           "[fusion][corridor]") {
   // Non-metric (monocular) SLAM: positions at a third of the true scale.
   auto sim = posefuse::simulate_corridor({}, 3);
-  for (auto& s : sim.log.slam)
-    for (double& v : s.p) v /= 3.0;
+  for (auto& s : sim.log.slam) s.position_m /= 3.0;
   const auto r = posefuse::run_corridor(sim.log);
   INFO("anchors " << r.gated_anchors << ", fused " << r.gated_fused << " of " << r.slam_valid);
   CHECK((has_warning(r, "gated_fuser: SLAM map never anchored") ||
@@ -305,7 +312,7 @@ TEST_CASE("Corridor: an IMU that stops halfway falls back to the encoder heading
   cfg.disturbance_uT = 0;
   auto sim = posefuse::simulate_corridor(cfg, 1);
   const std::int64_t half = (sim.log.imu.front().t_ns + sim.log.imu.back().t_ns) / 2;
-  std::erase_if(sim.log.imu, [half](const posefuse::ImuRecord& r) { return r.t_ns > half; });
+  std::erase_if(sim.log.imu, [half](const posefuse::ImuSample& r) { return r.t_ns > half; });
   const auto r = posefuse::run_corridor(sim.log);
   const auto& odom = r.metrics[kOdom].yaw_error_after_turn_deg;
   REQUIRE(odom.size() == 4);
@@ -333,13 +340,14 @@ TEST_CASE("Corridor: the compass is aligned to the encoder heading, even when th
   REQUIRE(turn.turn);
   const std::int64_t t_mid = posefuse::CorridorSimConfig{}.t0_ns +
                              std::int64_t(0.5 * (turn.t_start_s + turn.t_end_s) * 1e9);
-  std::erase_if(sim.log.imu, [t_mid](const posefuse::ImuRecord& r) { return r.t_ns < t_mid; });
+  std::erase_if(sim.log.imu, [t_mid](const posefuse::ImuSample& r) { return r.t_ns < t_mid; });
   const auto r = posefuse::run_corridor(sim.log);
   // The robot's heading when the IMU starts (what assuming 0 would get wrong).
-  const auto g0 = posefuse::interpolate_track(r.groundtruth, r.dead_reckoning.front().t_s +
-                                                                 double(t_mid - sim.log.wheels.front().t_ns) * 1e-9);
+  const auto g0 = posefuse::interpolate_at(
+      r.groundtruth, r.dead_reckoning.t_s.front() +
+                         posefuse::seconds_between(t_mid, sim.log.wheels.front().t_ns));
   REQUIRE(g0);
-  CHECK(g0->theta > 30.0 * std::numbers::pi / 180.0);
+  CHECK((*g0)(2) > 30.0 * std::numbers::pi / 180.0);
   const auto& odom = r.metrics[kOdom].yaw_error_after_turn_deg;
   REQUIRE(odom.size() == 4);
   INFO("odometry_only after turns: " << odom[0] << ", " << odom[1] << ", " << odom[2] << ", " << odom[3]);
@@ -370,7 +378,85 @@ TEST_CASE("Corridor: max_yaw_error_deg is the largest after-turn error, with or 
 TEST_CASE("Corridor: ground truth not starting at the odometry origin is warned about",
           "[fusion][corridor]") {
   auto sim = posefuse::simulate_corridor({}, 1);
-  for (auto& g : sim.log.groundtruth) g.yaw = posefuse::wrap_angle(g.yaw + 0.5);
+  for (auto& g : sim.log.groundtruth) g.pose(2) = posefuse::wrap_angle(g.pose(2) + 0.5);
   const auto r = posefuse::run_corridor(sim.log);
   CHECK(has_warning(r, "assume ground truth in the odometry frame"));
+}
+
+TEST_CASE("Corridor: the log clock is exact and cannot overflow", "[fusion][corridor][overflow]") {
+  constexpr std::int64_t lo = std::numeric_limits<std::int64_t>::min();
+  constexpr std::int64_t hi = std::numeric_limits<std::int64_t>::max();
+  const posefuse::corridor::LogClock c{1'600'000'000'000'000'000};
+  CHECK(c(1'600'000'000'000'000'000) == 0.0);
+  CHECK(c(1'600'000'142'199'379'099) == double(142'199'379'099) * 1e-9);  // the exact difference, once rounded
+  CHECK(c(1'599'999'999'000'000'000) == -1.0);
+  // Regression: t - t0 overflowed int64 for stamps this far apart.
+  CHECK(posefuse::corridor::LogClock{lo}(hi) == Approx(1.8446744073709552e10).epsilon(1e-15));
+  CHECK(posefuse::corridor::LogClock{hi}(lo) == Approx(-1.8446744073709552e10).epsilon(1e-15));
+  // A simulated log at the very start of the int64 clock runs like any other.
+  posefuse::CorridorSimConfig cfg;
+  cfg.t0_ns = lo;
+  const auto sim = posefuse::simulate_corridor(cfg, 1);
+  const auto span = posefuse::corridor::log_span(sim.log);
+  CHECK(span.clock.t0_ns >= lo);
+  CHECK(span.duration_s == Approx(sim.duration_s).margin(0.01));
+  const auto r = posefuse::run_corridor(sim.log);
+  CHECK(r.duration_s == span.duration_s);
+  // Only the clock's origin differs from the default run: every figure is the same.
+  const auto ref = posefuse::run_corridor(posefuse::simulate_corridor({}, 1).log);
+  for (std::size_t k = 0; k < 4; ++k) {
+    CHECK(r.metrics[k].loop_closure_error_m == ref.metrics[k].loop_closure_error_m);
+    CHECK(r.metrics[k].rmse_m == ref.metrics[k].rmse_m);
+    CHECK(r.metrics[k].time_without_pose_s == ref.metrics[k].time_without_pose_s);
+  }
+}
+
+TEST_CASE("Corridor: the steps of the runner on their own", "[fusion][corridor]") {
+  const auto sim = posefuse::simulate_corridor({}, 1);
+  const auto& log = sim.log;
+  // Magnetometer: the horizontal fit over the whole log, or none.
+  const auto fitted = posefuse::corridor::calibrate_magnetometer(log, true);
+  CHECK(fitted.calibrated);
+  CHECK(fitted.note == "horizontal hard/soft-iron ellipse fit over " + std::to_string(log.imu.size()) +
+                           " readings");
+  const auto off = posefuse::corridor::calibrate_magnetometer(log, false);
+  CHECK_FALSE(off.calibrated);
+  CHECK(off.note == "not calibrated (disabled)");
+  CHECK(off.calibration.soft_iron.isIdentity());
+  auto few = log;
+  few.imu.resize(10);
+  CHECK(posefuse::corridor::calibrate_magnetometer(few, true).note ==
+        "not calibrated: fewer than 20 readings");
+  // Attitude age: 5 median IMU periods (10 ms).
+  CHECK(posefuse::corridor::attitude_max_age(log, {}, posefuse::corridor::log_span(log).clock) ==
+        Approx(0.05).margin(0.001));
+  // The attitude tracker: fresh within the age limit only.
+  posefuse::corridor::AttitudeTracker att({0.98}, 0.0, 0.05);
+  CHECK_FALSE(att.fresh_at(0.0));
+  att.on_imu(log.imu[0], 1.0);
+  CHECK(att.fresh_at(1.04));
+  CHECK_FALSE(att.fresh_at(1.06));
+  // The odometry tracker interpolates to a time between two wheel samples.
+  const posefuse::DiffDriveParams dd{log.params.ticks_per_rev, log.params.wheel_radius_m,
+                                     log.params.track_width_m};
+  posefuse::corridor::OdometryTracker odo(dd, {});
+  double stale = 0;
+  const std::size_t k = log.wheels.size() / 3;  // on the move
+  for (std::size_t i = 0; i + 1 < k; ++i) (void)odo.on_wheel(log.wheels[i], 0.02 * double(i), att, stale);
+  const auto a = odo.latest();
+  const auto b = odo.on_wheel(log.wheels[k - 1], 0.02 * double(k - 1), att, stale);
+  const auto mid = odo.at(0.02 * (double(k - 1) - 0.5));
+  CHECK(mid.dr.x == Approx(0.5 * (a.dr.x + b.dr.x)));
+  CHECK(mid.dr.y == Approx(0.5 * (a.dr.y + b.dr.y)));
+  CHECK(odo.at(1e9).dr.x == Approx(b.dr.x));  // clamped to the latest sample
+  CHECK(odo.at(-1e9).dr.x == a.dr.x);         // ... and to the previous one
+  CHECK(stale > 0);                   // the attitude above is old for these wheel times
+}
+
+TEST_CASE("Corridor: an in-memory log with SLAM rows out of time order is an error",
+          "[fusion][corridor]") {
+  auto sim = posefuse::simulate_corridor({}, 1);
+  std::swap(sim.log.slam[100], sim.log.slam[101]);
+  CHECK_THROWS_AS(posefuse::run_corridor(sim.log), posefuse::invalid_argument);
+  CHECK_THROWS_WITH(posefuse::run_corridor(sim.log), Catch::Contains("stream 2 is not in time order"));
 }

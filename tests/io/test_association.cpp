@@ -143,16 +143,16 @@ TEST_CASE("Association: trajectories are reduced to the matched poses", "[io][as
   const posefuse::Trajectory ref = posefuse::test::make_vehicle_trajectory(50, 1, 10.0);
   // Estimate at 5 Hz with 3 ms clock jitter-free offset.
   posefuse::Trajectory est;
-  for (std::size_t k = 0; k < 50; k += 2) est.push_back(ref.stamps[k] + 0.003, ref.poses[k]);
+  for (std::size_t k = 0; k < 50; k += 2) est.push_back(ref.t_s[k] + 0.003, ref.poses[k]);
   const posefuse::AssociatedTrajectories sync = posefuse::associate(ref, est);
   REQUIRE(sync.ref.size() == 25);
   REQUIRE(sync.est.size() == 25);
   for (std::size_t k = 0; k < 25; ++k) {
-    CHECK(sync.ref.stamps[k] == ref.stamps[2 * k]);
-    CHECK(sync.est.stamps[k] == est.stamps[k]);  // own clock kept
+    CHECK(sync.ref.t_s[k] == ref.t_s[2 * k]);
+    CHECK(sync.est.t_s[k] == est.t_s[k]);  // own clock kept
     CHECK(sync.ref.poses[k].matrix() == sync.est.poses[k].matrix());
   }
   posefuse::Trajectory broken = est;
-  broken.stamps[1] = broken.stamps[0];
+  broken.t_s[1] = broken.t_s[0];
   CHECK_THROWS_AS(posefuse::associate(ref, broken), posefuse::invalid_argument);
 }

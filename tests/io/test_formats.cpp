@@ -69,7 +69,7 @@ TEST_CASE("Formats: KITTI writer and reader round-trip bit-exactly", "[io][kitti
       posefuse::read_kitti(dir.path() / "poses.txt", dir.path() / "times.txt");
   REQUIRE(back.size() == traj.size());
   for (std::size_t k = 0; k < traj.size(); ++k) {
-    CHECK(back.stamps[k] == traj.stamps[k]);
+    CHECK(back.t_s[k] == traj.t_s[k]);
     CHECK(back.poses[k].matrix() == traj.poses[k].matrix());
   }
 }
@@ -79,7 +79,7 @@ TEST_CASE("Formats: KITTI without times gets frame-index stamps", "[io][kitti]")
   const auto file = dir.write("p.txt", kIdentityRow + kIdentityRow + "\n" + kIdentityRow);
   const posefuse::Trajectory traj = posefuse::read_kitti(file);
   REQUIRE(traj.size() == 3);
-  CHECK(traj.stamps == std::vector<double>{0.0, 1.0, 2.0});
+  CHECK(traj.t_s == std::vector<double>{0.0, 1.0, 2.0});
   CHECK(traj.poses[2].isApprox(Eigen::Isometry3d::Identity(), 0.0));
 }
 
@@ -90,7 +90,7 @@ TEST_CASE("Formats: TUM round trip is bit-exact in stamps and positions", "[io][
   const posefuse::Trajectory back = posefuse::read_tum(dir.path() / "t.tum");
   REQUIRE(back.size() == traj.size());
   for (std::size_t k = 0; k < traj.size(); ++k) {
-    CHECK(back.stamps[k] == traj.stamps[k]);
+    CHECK(back.t_s[k] == traj.t_s[k]);
     CHECK(back.poses[k].translation() == traj.poses[k].translation());
     // Rotations pass through a quaternion: equal to a few ulp, not bit for bit.
     CHECK((back.poses[k].linear() - traj.poses[k].linear()).cwiseAbs().maxCoeff() < 2e-15);
@@ -104,7 +104,7 @@ TEST_CASE("Formats: TUM reader skips comments, blank lines and CRLF", "[io][tum]
                            " " + std::to_string(c) + "\r\n\t2.5\t4 5 6  0 0 0 1.00001\r\n";
   const posefuse::Trajectory traj = posefuse::read_tum(dir.write("a.tum", text));
   REQUIRE(traj.size() == 2);
-  CHECK(traj.stamps[1] == 2.5);
+  CHECK(traj.t_s[1] == 2.5);
   CHECK(traj.poses[0].translation() == Eigen::Vector3d(1, 2, 3));
   CHECK(Eigen::AngleAxisd(traj.poses[0].linear()).angle() == Approx(0.5).margin(1e-6));
   // The near-unit quaternion was normalised.
@@ -247,8 +247,8 @@ TEST_CASE("Formats: parse_format and read_trajectory dispatch", "[io]") {
   const posefuse::Trajectory traj = random_trajectory(5, 3);
   posefuse::write_trajectory(dir.path() / "a.tum", traj, posefuse::Format::kTum);
   posefuse::write_trajectory(dir.path() / "a.kitti", traj, posefuse::Format::kKitti);
-  CHECK(posefuse::read_trajectory(dir.path() / "a.tum", posefuse::Format::kTum).stamps ==
-        traj.stamps);
+  CHECK(posefuse::read_trajectory(dir.path() / "a.tum", posefuse::Format::kTum).t_s ==
+        traj.t_s);
   CHECK(posefuse::read_trajectory(dir.path() / "a.kitti", posefuse::Format::kKitti).size() == 5);
   CHECK_THROWS_AS(posefuse::read_trajectory(dir.path() / "a.tum", posefuse::Format::kTum,
                                             dir.path() / "a.kitti"),
@@ -258,7 +258,7 @@ TEST_CASE("Formats: parse_format and read_trajectory dispatch", "[io]") {
 TEST_CASE("Formats: writers refuse invalid trajectories", "[io][errors]") {
   TempDir dir("invalid");
   posefuse::Trajectory traj = random_trajectory(3, 5);
-  traj.stamps[2] = traj.stamps[1];
+  traj.t_s[2] = traj.t_s[1];
   CHECK_THROWS_AS(posefuse::write_tum(dir.path() / "x.tum", traj), posefuse::invalid_argument);
   CHECK_THROWS_AS(posefuse::write_kitti_times(dir.path() / "t.txt", traj),
                   posefuse::invalid_argument);
@@ -278,7 +278,7 @@ TEST_CASE("Formats: real KITTI 06 files read with default tolerances", "[io][dat
   }
   const posefuse::Trajectory mono = posefuse::read_tum(dir / "orbslam2_mono.tum");
   CHECK(mono.size() == 1101);
-  CHECK(mono.stamps.front() == 0.0);
+  CHECK(mono.t_s.front() == 0.0);
   // CVO's rotations drift to |R^T R - I| = 4.1e-4; a 1e-4 tolerance rejects them.
   posefuse::ReadOptions strict;
   strict.rotation_tolerance = 1e-4;

@@ -5,10 +5,10 @@
 #include <posefuse/io/association.hpp>
 #include <posefuse/io/formats.hpp>
 #include <posefuse/io/kitti.hpp>
-#include <posefuse/io/plane.hpp>
+#include <posefuse/core/plane.hpp>
 #include <posefuse/io/read_options.hpp>
 #include <posefuse/io/robot_log.hpp>
-#include <posefuse/io/trajectory.hpp>
+#include <posefuse/core/trajectory.hpp>
 #include <posefuse/io/tum.hpp>
 
 TEST_CASE("Io headers: all io headers compile together", "[io]") {

@@ -5,8 +5,8 @@
 #include <limits>
 #include <vector>
 
-#include <posefuse/io/plane.hpp>
-#include <posefuse/io/trajectory.hpp>
+#include <posefuse/core/plane.hpp>
+#include <posefuse/core/trajectory.hpp>
 
 namespace {
 
@@ -33,11 +33,11 @@ TEST_CASE("Trajectory: validate rejects every broken invariant", "[io][trajector
   traj.push_back(0.0, at(0, 0, 0));
   traj.push_back(0.1, at(1, 0, 0));
   SECTION("mismatched lengths") {
-    traj.stamps.push_back(0.2);
+    traj.t_s.push_back(0.2);
     CHECK_THROWS_WITH(traj.validate(), Catch::Contains("3 stamps but 2 poses"));
   }
   SECTION("NaN stamp") {
-    traj.stamps[1] = std::numeric_limits<double>::quiet_NaN();
+    traj.t_s[1] = std::numeric_limits<double>::quiet_NaN();
     CHECK_THROWS_WITH(traj.validate(), Catch::Contains("stamp 1 is not finite"));
   }
   SECTION("Inf in a pose") {
@@ -45,11 +45,11 @@ TEST_CASE("Trajectory: validate rejects every broken invariant", "[io][trajector
     CHECK_THROWS_WITH(traj.validate(), Catch::Contains("pose 0 is not finite"));
   }
   SECTION("equal stamps") {
-    traj.stamps[1] = 0.0;
+    traj.t_s[1] = 0.0;
     CHECK_THROWS_AS(traj.validate(), posefuse::invalid_argument);
   }
   SECTION("decreasing stamps") {
-    traj.stamps[1] = -1.0;
+    traj.t_s[1] = -1.0;
     CHECK_THROWS_WITH(traj.validate(), Catch::Contains("not strictly increasing at index 1"));
   }
 }
@@ -65,7 +65,7 @@ TEST_CASE("Trajectory: positions, select and path_length", "[io][trajectory]") {
   CHECK(posefuse::path_length(traj) == 17.0);
   const std::vector<std::size_t> ids{2, 0, 2};
   const posefuse::Trajectory sub = posefuse::select(traj, ids);
-  CHECK(sub.stamps == std::vector<double>{2.0, 0.0, 2.0});
+  CHECK(sub.t_s == std::vector<double>{2.0, 0.0, 2.0});
   CHECK(sub.poses[0].translation() == Eigen::Vector3d(3, 4, 12));
   const std::vector<std::size_t> bad{3};
   CHECK_THROWS_AS(posefuse::select(traj, bad), posefuse::invalid_argument);

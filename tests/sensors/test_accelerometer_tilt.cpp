@@ -4,7 +4,7 @@
 #include <cmath>
 #include <numbers>
 #include <posefuse/core/angles.hpp>
-#include <posefuse/core/rotation.hpp>
+#include <posefuse/lie/rotation.hpp>
 #include <posefuse/sensors/accelerometer_tilt.hpp>
 #include <random>
 
@@ -85,12 +85,12 @@ TEMPLATE_TEST_CASE("AccelerometerTilt: the seed's angles in REP-103 axes", "[sen
 TEST_CASE("AccelerometerTilt: the stage flags unusable readings", "[sensors][tilt]") {
   posefuse::AccelerometerTiltStage stage;
   posefuse::ImuSample s;
-  s.t_s = 1.0;
+  s.t_ns = 1'000'000'000;
   s.accel_mps2 << 0, 0, 9.81;
   posefuse::TiltedImu out = stage(s);
   CHECK(out.status == posefuse::SampleStatus::kOk);
   CHECK(out.tilt.roll == 0);
-  CHECK(out.imu.t_s == 1.0);
+  CHECK(out.imu.t_ns == 1'000'000'000);
   s.accel_mps2.x() = std::numeric_limits<double>::quiet_NaN();
   CHECK(stage(s).status == posefuse::SampleStatus::kNonFinite);
   s.accel_mps2.setZero();

@@ -7,10 +7,13 @@
 #include <numbers>
 #include <posefuse/core/angles.hpp>
 #include <posefuse/core/error.hpp>
-#include <posefuse/core/rotation.hpp>
+#include <posefuse/core/samples.hpp>
+#include <posefuse/lie/rotation.hpp>
 #include <posefuse/sensors/compass.hpp>
 #include <posefuse/sensors/magnetometer_calibration.hpp>
 #include <random>
+#include <ranges>
+#include <span>
 #include <vector>
 
 namespace {
@@ -157,12 +160,12 @@ TEST_CASE("Compass: stage applies calibration and holds yaw on bad readings", "[
   cal.hard_iron << 5, -3, 2;
   posefuse::CompassStage stage(cal);
   posefuse::TiltedImu in;
-  in.imu.t_s = 2.0;
+  in.imu.t_ns = 2'000'000'000;
   in.tilt = {0.1, -0.05};
   in.imu.mag_uT = reading(0.1, -0.05, 0.4) + cal.hard_iron;
   posefuse::Attitude a = stage(in);
   CHECK(a.status == posefuse::SampleStatus::kOk);
-  CHECK(a.t_s == 2.0);
+  CHECK(a.t_ns == 2'000'000'000);
   CHECK(a.roll == 0.1);
   CHECK(a.pitch == -0.05);
   CHECK(a.yaw == Approx(0.4).epsilon(1e-12));
@@ -171,4 +174,132 @@ TEST_CASE("Compass: stage applies calibration and holds yaw on bad readings", "[
   CHECK(a.status == posefuse::SampleStatus::kNonFinite);
   CHECK(a.yaw == Approx(0.4).epsilon(1e-12));
   CHECK_THROWS_AS(posefuse::CompassStage(cal, std::nan("")), posefuse::invalid_argument);
+}
+
+namespace {
+/// Raw horizontal readings of a robot turning about z through `turn_rad` in
+/// `n` steps: level body, so m = D (R_z(yaw)^T b_w) + h, with 0.2 uT noise.
+std::vector<Eigen::Vector2d> turning_readings(const Eigen::Matrix2d& D, const Eigen::Vector2d& h,
+                                              double turn_rad, int n, std::vector<double>* yaws = nullptr) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 0.2);
+  std::vector<Eigen::Vector2d> out;
+  for (int i = 0; i < n; ++i) {
+    const double yaw = turn_rad * i / n;
+    const Eigen::Vector3d b = reading(0.0, 0.0, yaw);
+    out.push_back(D * b.head<2>() + h + Eigen::Vector2d(noise(rng), noise(rng)));
+    if (yaws != nullptr) yaws->push_back(yaw);
+  }
+  return out;
+}
+}  // namespace
+
+TEST_CASE("Compass: horizontal ellipse fit recovers hard and soft iron of a turning robot",
+          "[sensors][compass][calibration]") {
+  Eigen::Matrix2d D;
+  D << 1.15, 0.08,  //
+      0.08, 0.90;
+  const Eigen::Vector2d h(9.0, -14.0);
+  std::vector<double> yaws;
+  const auto raw = turning_readings(D, h, 2 * std::numbers::pi, 720, &yaws);
+  const posefuse::HorizontalEllipseFit fit = posefuse::fit_horizontal_ellipse(raw);
+  REQUIRE(fit.ok());
+  CHECK(fit.readings == 720);
+  CHECK(fit.coverage_deg == 360.0);
+  const posefuse::MagnetometerCalibration& cal = fit.calibration;
+  CHECK((cal.hard_iron.head<2>() - h).norm() < 0.1);
+  CHECK(cal.hard_iron.z() == 0.0);
+  CHECK(cal.soft_iron(2, 2) == 1.0);
+  CHECK(cal.soft_iron(0, 2) == 0.0);
+  CHECK(cal.soft_iron(2, 1) == 0.0);
+  // S keeps the geometric-mean radius: det S = 1, so S = D^-1 sqrt(det D) for a symmetric D.
+  const Eigen::Matrix2d S = cal.soft_iron.topLeftCorner<2, 2>();
+  CHECK(S.determinant() == Approx(1.0).epsilon(1e-12));
+  CHECK((S - D.inverse() * std::sqrt(D.determinant())).norm() < 5e-3);
+  CHECK((S - S.transpose()).norm() < 1e-12);
+  // Calibrated, the level heading is right to a fraction of a degree; raw, it is degrees off.
+  double worst = 0, worst_raw = 0;
+  for (std::size_t i = 0; i < raw.size(); ++i) {
+    const Eigen::Vector3d m(raw[i].x(), raw[i].y(), -40.0);
+    worst = std::max(worst, std::abs(posefuse::angle_diff(
+                                posefuse::tilt_compensated_heading(cal.apply(m), 0.0, 0.0), yaws[i])));
+    worst_raw = std::max(worst_raw, std::abs(posefuse::angle_diff(
+                                        posefuse::tilt_compensated_heading(m, 0.0, 0.0), yaws[i])));
+  }
+  CHECK(worst < posefuse::deg2rad(1.5));
+  CHECK(worst_raw > posefuse::deg2rad(20.0));
+}
+
+TEST_CASE("Compass: horizontal ellipse fit takes any range of 2-vectors, e.g. a view of IMU samples",
+          "[sensors][compass][calibration]") {
+  const auto raw = turning_readings(Eigen::Matrix2d::Identity(), Eigen::Vector2d(3, 4), 2 * std::numbers::pi, 100);
+  std::vector<posefuse::ImuSample> imu(raw.size());
+  for (std::size_t i = 0; i < raw.size(); ++i) imu[i].mag_uT << raw[i], -40.0;
+  const auto view = imu | std::views::transform([](const posefuse::ImuSample& s) {
+                      return Eigen::Vector2d(s.mag_uT.head<2>());
+                    });
+  const auto a = posefuse::fit_horizontal_ellipse(view);
+  const auto b = posefuse::fit_horizontal_ellipse(raw);
+  REQUIRE(a.ok());
+  CHECK(a.calibration.hard_iron == b.calibration.hard_iron);
+  CHECK(a.calibration.soft_iron == b.calibration.soft_iron);
+  CHECK((a.calibration.hard_iron.head<2>() - Eigen::Vector2d(3, 4)).norm() < 0.1);
+}
+
+TEST_CASE("Compass: horizontal ellipse fit reports why it cannot calibrate",
+          "[sensors][compass][calibration]") {
+  using posefuse::EllipseFitStatus;
+  const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
+  const Eigen::Vector2d h(2, -3);
+  const auto check_fails = [](const std::vector<Eigen::Vector2d>& r, EllipseFitStatus want) {
+    const auto fit = posefuse::fit_horizontal_ellipse(r);
+    CHECK(fit.status == want);
+    CHECK_FALSE(fit.ok());
+    CHECK(fit.calibration.hard_iron.isZero());  // identity calibration on failure
+    CHECK(fit.calibration.soft_iron.isIdentity());
+  };
+  check_fails({}, EllipseFitStatus::kTooFewReadings);
+  check_fails(turning_readings(I, h, 2 * std::numbers::pi, 19), EllipseFitStatus::kTooFewReadings);
+  check_fails(std::vector<Eigen::Vector2d>(50, Eigen::Vector2d(1, 2)), EllipseFitStatus::kConstantReadings);
+  auto with_nan = turning_readings(I, h, 2 * std::numbers::pi, 50);
+  with_nan[10].x() = std::nan("");
+  check_fails(with_nan, EllipseFitStatus::kNonFinite);
+  // Half a turn fits an ellipse but does not determine it: too little turning.
+  const auto half = posefuse::fit_horizontal_ellipse(turning_readings(I, h, std::numbers::pi, 200));
+  CHECK(half.status == EllipseFitStatus::kTooLittleTurning);
+  CHECK(half.coverage_deg < 270.0);
+  // A soft iron squeezing one axis 3:1 (eigenvalue ratio 9 > 4) is not plausible.
+  Eigen::Matrix2d squeeze = I;
+  squeeze(1, 1) = 1.0 / 3.0;
+  check_fails(turning_readings(squeeze, h, 2 * std::numbers::pi, 200), EllipseFitStatus::kNotAnEllipse);
+  // ... unless the limit allows it.
+  posefuse::HorizontalEllipseFitOptions loose;
+  loose.max_eigenvalue_ratio = 10.0;
+  CHECK(posefuse::fit_horizontal_ellipse(turning_readings(squeeze, h, 2 * std::numbers::pi, 200), loose).ok());
+  // Readings on a line are no ellipse.
+  std::vector<Eigen::Vector2d> line;
+  for (int i = 0; i < 50; ++i) line.emplace_back(0.1 * i, 0.2 * i);
+  check_fails(line, EllipseFitStatus::kNotAnEllipse);
+  // The reasons as the runner prints them.
+  CHECK(posefuse::to_string(EllipseFitStatus::kTooFewReadings) == "fewer than 20 readings");
+  CHECK(posefuse::to_string(EllipseFitStatus::kTooLittleTurning) ==
+        "the robot turned through less than 270 deg");
+  CHECK(posefuse::to_string(EllipseFitStatus::kNotAnEllipse) == "readings are not on a plausible ellipse");
+}
+
+TEST_CASE("Compass: ellipsoid fit takes a std::span and a view as well as a vector",
+          "[sensors][compass][calibration]") {
+  std::mt19937 rng(3);
+  std::normal_distribution<double> n(0.0, 1.0);
+  std::vector<Eigen::Vector3d> raw;
+  for (int i = 0; i < 200; ++i) {
+    const Eigen::Quaterniond q = Eigen::Quaterniond(n(rng), n(rng), n(rng), n(rng)).normalized();
+    raw.push_back(q.toRotationMatrix().transpose() * field_world<double>() + Eigen::Vector3d(4, -2, 7));
+  }
+  const auto a = posefuse::fit_ellipsoid(raw);
+  const auto b = posefuse::fit_ellipsoid(std::span<const Eigen::Vector3d>(raw));
+  const auto c = posefuse::fit_ellipsoid(raw | std::views::transform([](const Eigen::Vector3d& v) { return v; }));
+  CHECK(a.hard_iron == b.hard_iron);
+  CHECK(a.soft_iron == c.soft_iron);
+  CHECK((a.hard_iron - Eigen::Vector3d(4, -2, 7)).norm() < 1e-6);
 }

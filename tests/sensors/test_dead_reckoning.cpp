@@ -122,13 +122,15 @@ TEST_CASE("DeadReckoning: covariance stays symmetric PSD and grows as predicted"
   m.cov = Eigen::Vector2d(s2, q2).asDiagonal();
   double prev_trace = 0.0, sum = 0.0;
   for (int k = 0; k < n; ++k) {
-    m.t_s = 0.1 * (k + 1);
-    const posefuse::PoseWithCovariance p = dr(m);
+    m.t_ns = 100'000'000 * std::int64_t(k + 1);
+    const posefuse::PlanarPoseEstimate p = dr(m);
     REQUIRE(p.status == posefuse::SampleStatus::kOk);
-    REQUIRE(posefuse::is_positive_semidefinite(p.cov));
-    REQUIRE(p.cov == p.cov.transpose());
-    REQUIRE(p.cov.trace() > prev_trace);
-    prev_trace = p.cov.trace();
+    REQUIRE(p.t_ns == m.t_ns);
+    REQUIRE(posefuse::is_positive_semidefinite(p.pose.cov));
+    REQUIRE(p.pose.cov == p.pose.cov.transpose());
+    REQUIRE(p.pose.cov.trace() > prev_trace);
+    REQUIRE(p.pose.mean.x == dr.pose().x);
+    prev_trace = p.pose.cov.trace();
     sum += (k + 0.5) * (k + 0.5);
   }
   const Eigen::Matrix3d& P = dr.covariance();
@@ -142,8 +144,8 @@ TEST_CASE("DeadReckoning: covariance stays symmetric PSD and grows as predicted"
   m.dtheta_rad = 0.03;
   m.cov << 1e-6, 2e-7, 2e-7, 1e-5;
   for (int k = 0; k < 1000; ++k) {
-    const posefuse::PoseWithCovariance p = de(m);
-    REQUIRE(posefuse::is_positive_semidefinite(p.cov));
+    const posefuse::PlanarPoseEstimate p = de(m);
+    REQUIRE(posefuse::is_positive_semidefinite(p.pose.cov));
   }
 }
 
@@ -164,8 +166,11 @@ TEST_CASE("DeadReckoning: reset re-anchors, bad inputs are reported", "[sensors]
 
   posefuse::BodyMotion m;
   m.ds_m = std::nan("");
-  const posefuse::PoseWithCovariance p = dr(m);
+  const posefuse::PlanarPoseEstimate p = dr(m);
   CHECK(p.status == posefuse::SampleStatus::kNonFinite);
-  CHECK(p.pose.x == 3);
-  CHECK(p.cov == P0);
+  CHECK(p.pose.mean.x == 3);
+  CHECK(p.pose.cov == P0);
+  const posefuse::Gaussian<PlanarPose<double>> b = dr.belief();
+  CHECK(b.mean.x == 3);
+  CHECK(b.cov == P0);
 }

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <numbers>
 #include <posefuse/core/angles.hpp>
-#include <posefuse/core/rotation.hpp>
+#include <posefuse/lie/rotation.hpp>
 #include <posefuse/sensors/pipelines.hpp>
 #include <type_traits>
 
@@ -13,13 +13,13 @@ using namespace posefuse;
 
 static_assert(std::is_same_v<AttitudePipeline::Input, ImuSample>);
 static_assert(std::is_same_v<AttitudePipeline::Output, Attitude>);
-static_assert(std::is_same_v<OdometryPipeline::Input, StampedWheelTicks>);
-static_assert(std::is_same_v<OdometryPipeline::Output, PoseWithCovariance>);
+static_assert(std::is_same_v<OdometryPipeline::Input, WheelSample>);
+static_assert(std::is_same_v<OdometryPipeline::Output, PlanarPoseEstimate>);
 static_assert(Stage<WheelOdometry> && Stage<DeadReckoning> && Stage<CompassStage>);
 // WheelOdometry -> DeadReckoning is also a valid two-stage chain.
 static_assert(std::is_same_v<decltype(make_pipeline(WheelOdometry(DiffDriveParams{1, 1, 1}),
                                                     DeadReckoning{}))::Output,
-                             PoseWithCovariance>);
+                             PlanarPoseEstimate>);
 
 namespace {
 const Eigen::Vector3d kFieldWorld(50 * std::cos(0.925), 0.0, -50 * std::sin(0.925));  // dip 53 deg
@@ -29,7 +29,7 @@ const Eigen::Vector3d kFieldWorld(50 * std::cos(0.925), 0.0, -50 * std::sin(0.92
 ImuSample imu_at(double t, double roll, double pitch, double yaw, double yaw_rate) {
   const Eigen::Matrix3d R = rotation_from_euler_zyx(EulerZYX<double>{roll, pitch, yaw});
   ImuSample s;
-  s.t_s = t;
+  s.t_ns = ns_from_seconds(t);
   s.accel_mps2 = R.transpose() * Eigen::Vector3d(0, 0, 9.81);
   s.gyro_radps = R.transpose() * Eigen::Vector3d(0, 0, yaw_rate);
   s.mag_uT = R.transpose() * kFieldWorld;
@@ -43,7 +43,7 @@ TEST_CASE("Pipelines: attitude chain recovers a constant attitude", "[sensors][p
   CHECK(a.status == SampleStatus::kFirst);
   for (int k = 1; k <= 100; ++k) a = att(imu_at(0.01 * k, 0.1, -0.05, 0.7, 0.0));
   CHECK(a.status == SampleStatus::kOk);
-  CHECK(a.t_s == Approx(1.0));
+  CHECK(a.t_ns == 1'000'000'000);
   CHECK(a.roll == Approx(0.1).epsilon(1e-12));
   CHECK(a.pitch == Approx(-0.05).epsilon(1e-12));
   CHECK(a.yaw == Approx(0.7).epsilon(1e-12));
@@ -102,31 +102,32 @@ TEST_CASE("Pipelines: odometry chain drives the closed-form circle", "[sensors][
   const double m = p.metres_per_tick();
   const double ds = m * 110.0, dth = m * 20.0 / 0.4, rho = ds / dth;
   WheelTicks ticks{};
-  PoseWithCovariance out, hand;
+  PlanarPoseEstimate out, hand;
   const int n = 2000;
+  constexpr std::int64_t kStep = 20'000'000;  // 0.02 s
   for (int k = 0; k <= n; ++k) {
-    const StampedWheelTicks in{0.02 * k, ticks};
+    const WheelSample in{kStep * k, ticks};
     out = odo(in);
     hand = s3(s2(s1(in)));
-    REQUIRE(out.pose.x == hand.pose.x);
-    REQUIRE(out.pose.theta == hand.pose.theta);
-    REQUIRE(out.cov == hand.cov);
+    REQUIRE(out.pose.mean.x == hand.pose.mean.x);
+    REQUIRE(out.pose.mean.theta == hand.pose.mean.theta);
+    REQUIRE(out.pose.cov == hand.pose.cov);
     ticks.fl += 100;
     ticks.bl += 100;
     ticks.fr += 120;
     ticks.br += 120;
   }
   CHECK(rho == Approx(2.2));
-  CHECK(out.pose.x == Approx(rho * std::sin(n * dth)).margin(1e-9));
-  CHECK(out.pose.y == Approx(rho * (1 - std::cos(n * dth))).margin(1e-9));
-  CHECK(angle_diff(out.pose.theta, n * dth) == Approx(0).margin(1e-9));
-  CHECK(out.t_s == Approx(40.0));
-  CHECK(is_positive_semidefinite(out.cov));
-  CHECK(out.cov(2, 2) > 0.0);
+  CHECK(out.pose.mean.x == Approx(rho * std::sin(n * dth)).margin(1e-9));
+  CHECK(out.pose.mean.y == Approx(rho * (1 - std::cos(n * dth))).margin(1e-9));
+  CHECK(angle_diff(out.pose.mean.theta, n * dth) == Approx(0).margin(1e-9));
+  CHECK(out.t_ns == 40'000'000'000);
+  CHECK(is_positive_semidefinite(out.pose.cov));
+  CHECK(out.pose.cov(2, 2) > 0.0);
 
   // Re-anchor the dead reckoning through the pipeline (what the fuser does on re-initialisation).
   odo.stage<2>().reset(PlanarPose<double>{1, 1, 0}, Eigen::Matrix3d::Identity() * 1e-4);
-  out = odo(StampedWheelTicks{0.02 * (n + 1), ticks});
-  CHECK(out.pose.x == Approx(1 + rho * std::sin(dth)).epsilon(1e-12));
-  CHECK(out.cov(0, 0) > 1e-4);
+  out = odo(WheelSample{kStep * (n + 1), ticks});
+  CHECK(out.pose.mean.x == Approx(1 + rho * std::sin(dth)).epsilon(1e-12));
+  CHECK(out.pose.cov(0, 0) > 1e-4);
 }

@@ -1,6 +1,9 @@
 // Tests for sensors/wheel_odometry.hpp (seed 001 eq 8-9).
 #include <catch2/catch.hpp>
 
+#include <cstdint>
+#include <limits>
+
 #include <cmath>
 #include <numbers>
 #include <posefuse/core/error.hpp>
@@ -78,29 +81,60 @@ TEST_CASE("WheelOdometry: covariance of (ds, dtheta) from per-wheel noise", "[se
 }
 
 TEST_CASE("WheelOdometry: stage turns cumulative ticks into body motion", "[sensors][odometry]") {
+  using posefuse::WheelSample;
+  constexpr std::int64_t t0 = 10'000'000'000;  // 10 s
   posefuse::WheelOdometry odo(kParams);
-  posefuse::BodyMotion m = odo(posefuse::StampedWheelTicks{10.0, WheelTicks{1000, 1000, 1000, 1000}});
+  posefuse::BodyMotion m = odo(WheelSample{t0, WheelTicks{1000, 1000, 1000, 1000}});
   CHECK(m.status == posefuse::SampleStatus::kFirst);
   CHECK(m.dt_s == 0.0);
   CHECK(m.ds_m == 0.0);
   CHECK(m.v_mps == 0.0);
-  CHECK(m.t_s == 10.0);
+  CHECK(m.t_ns == t0);
   CHECK(m.cov.isZero());
   // +100/+204/+102/+200 ticks over 0.1 s: the hand-worked step above.
-  m = odo(posefuse::StampedWheelTicks{10.1, WheelTicks{1100, 1204, 1102, 1200}});
+  m = odo(WheelSample{t0 + 100'000'000, WheelTicks{1100, 1204, 1102, 1200}});
   CHECK(m.status == posefuse::SampleStatus::kOk);
-  CHECK(m.dt_s == Approx(0.1));
+  CHECK(m.dt_s == Approx(0.1).epsilon(1e-15));
+  CHECK(m.t_ns == t0 + 100'000'000);
   CHECK(m.ds_m == Approx(0.04759512870188536).epsilon(1e-12));
   CHECK(m.dtheta_rad == Approx(0.07932521450314228).epsilon(1e-12));
   CHECK(m.v_mps == Approx(0.4759512870188536).epsilon(1e-9));
   CHECK(m.w_radps == Approx(0.7932521450314228).epsilon(1e-9));
   CHECK(m.cov(0, 0) == Approx(2.056167583560283e-09).epsilon(1e-9));
-  // Non-increasing or non-finite stamps are configuration errors; the state is kept.
-  CHECK_THROWS_AS(odo(posefuse::StampedWheelTicks{10.1, WheelTicks{}}), posefuse::invalid_argument);
-  CHECK_THROWS_AS(odo(posefuse::StampedWheelTicks{9.0, WheelTicks{}}), posefuse::invalid_argument);
-  CHECK_THROWS_AS(odo(posefuse::StampedWheelTicks{std::nan(""), WheelTicks{}}), posefuse::invalid_argument);
-  m = odo(posefuse::StampedWheelTicks{10.2, WheelTicks{1200, 1408, 1204, 1400}});
+  // Non-increasing stamps are configuration errors; the state is kept.
+  CHECK_THROWS_AS(odo(WheelSample{t0 + 100'000'000, WheelTicks{}}), posefuse::invalid_argument);
+  CHECK_THROWS_AS(odo(WheelSample{t0 - 1'000'000'000, WheelTicks{}}), posefuse::invalid_argument);
+  m = odo(WheelSample{t0 + 200'000'000, WheelTicks{1200, 1408, 1204, 1400}});
   CHECK(m.ds_m == Approx(0.04759512870188536).epsilon(1e-12));
   odo.reset();
-  CHECK(odo(posefuse::StampedWheelTicks{0.0, WheelTicks{}}).status == posefuse::SampleStatus::kFirst);
+  CHECK(odo(WheelSample{0, WheelTicks{}}).status == posefuse::SampleStatus::kFirst);
+}
+
+TEST_CASE("WheelOdometry: a non-finite side count is rejected", "[sensors][odometry]") {
+  posefuse::DiffDriveOdometry odo(kParams);
+  (void)odo(posefuse::StampedSideTicks{0, {0.0, 0.0}});
+  CHECK_THROWS_AS(odo(posefuse::StampedSideTicks{1, {std::nan(""), 0.0}}), posefuse::invalid_argument);
+  CHECK(odo(posefuse::StampedSideTicks{2, {10.0, 10.0}}).status == posefuse::SampleStatus::kOk);
+}
+
+TEST_CASE("WheelOdometry: stamps and counts at the ends of the int64 range do not overflow",
+          "[sensors][odometry][overflow]") {
+  constexpr std::int64_t lo = std::numeric_limits<std::int64_t>::min();
+  constexpr std::int64_t hi = std::numeric_limits<std::int64_t>::max();
+  // Regression: t_ns - previous t_ns overflowed for stamps this far apart.
+  posefuse::WheelOdometry odo(kParams);
+  (void)odo(posefuse::WheelSample{lo + 1, WheelTicks{}});
+  const posefuse::BodyMotion m = odo(posefuse::WheelSample{hi, WheelTicks{10, 10, 10, 10}});
+  CHECK(m.dt_s == Approx(2.0 * 9.223372036854775807e9).epsilon(1e-15));
+  CHECK(m.ds_m == Approx(10 * kParams.metres_per_tick()).epsilon(1e-12));
+  // tick_increment saturates instead of overflowing, and is exact when the difference fits.
+  const WheelTicks d = posefuse::tick_increment(WheelTicks{hi, lo, hi - 5, 7}, WheelTicks{lo, hi, hi, -3});
+  CHECK(d.fl == hi);
+  CHECK(d.fr == lo);
+  CHECK(d.bl == -5);
+  CHECK(d.br == 10);
+  CHECK(posefuse::saturating_difference(lo, 1) == lo);
+  CHECK(posefuse::saturating_difference(hi, -1) == hi);
+  CHECK(posefuse::saturating_difference(-1, lo) == hi);  // 2^63 - 1 exactly
+  CHECK(posefuse::saturating_difference(0, hi) == lo + 1);
 }

@@ -3,9 +3,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <numbers>
 #include <set>
-#include <posefuse/sim/corridor.hpp>
+#include <apps/sim/corridor.hpp>
+#include <posefuse/core/time.hpp>
 
 using posefuse::CorridorSimConfig;
 using posefuse::SlamState;
@@ -16,7 +19,7 @@ const posefuse::CorridorSimulation& sim1() {
   static const auto s = simulate_corridor({}, 1);
   return s;
 }
-double t_of(const CorridorSimConfig& c, std::int64_t t_ns) { return double(t_ns - c.t0_ns) * 1e-9; }
+double t_of(const CorridorSimConfig& c, std::int64_t t_ns) { return posefuse::seconds_between(t_ns, c.t0_ns); }
 }  // namespace
 
 TEST_CASE("Corridor sim: the same seed gives the same log, another seed another", "[sim]") {
@@ -31,11 +34,11 @@ TEST_CASE("Corridor sim: 14 m x 9 m counter-clockwise loop back to the start", "
   const auto& s = sim1();
   const auto& gt = s.log.groundtruth;
   REQUIRE(gt.size() > 1000);
-  CHECK(gt.front().x == 0.0);
-  CHECK(gt.front().yaw == 0.0);
-  CHECK(std::abs(gt.back().x) < 1e-9);
-  CHECK(std::abs(gt.back().y) < 1e-9);
-  CHECK(std::abs(gt.back().yaw) < 1e-9);
+  CHECK(gt.front().pose.x() == 0.0);
+  CHECK(gt.front().pose(2) == 0.0);
+  CHECK(std::abs(gt.back().pose.x()) < 1e-9);
+  CHECK(std::abs(gt.back().pose.y()) < 1e-9);
+  CHECK(std::abs(gt.back().pose(2)) < 1e-9);
   // Corners at the end of each leg: 2 = (14, 0), 3 = (14, 9), 4 = (0, 9).
   REQUIRE(s.manoeuvres.size() == 8);
   const double corners[3][2] = {{14, 0}, {14, 9}, {0, 9}};
@@ -45,16 +48,16 @@ TEST_CASE("Corridor sim: 14 m x 9 m counter-clockwise loop back to the start", "
       return t_of(CorridorSimConfig{}, g.t_ns) < v;
     });
     REQUIRE(it != gt.end());
-    CHECK(it->x == Approx(corners[k][0]).margin(1e-3));
-    CHECK(it->y == Approx(corners[k][1]).margin(1e-3));
+    CHECK(it->pose.x() == Approx(corners[k][0]).margin(1e-3));
+    CHECK(it->pose.y() == Approx(corners[k][1]).margin(1e-3));
   }
   // Counter-clockwise: every turn is +90°, and x, y stay inside the rectangle.
   for (const auto& m : s.manoeuvres) CHECK(m.t_end_s > m.t_start_s);
   for (const auto& g : gt) {
-    CHECK(g.x > -1e-6);
-    CHECK(g.x < 14 + 1e-6);
-    CHECK(g.y > -1e-6);
-    CHECK(g.y < 9 + 1e-6);
+    CHECK(g.pose.x() > -1e-6);
+    CHECK(g.pose.x() < 14 + 1e-6);
+    CHECK(g.pose.y() > -1e-6);
+    CHECK(g.pose.y() < 9 + 1e-6);
   }
 }
 
@@ -80,7 +83,7 @@ TEST_CASE("Corridor sim: asynchronous streams with strictly increasing, unshared
 TEST_CASE("Corridor sim: encoders count a full turn; the IMU reads gravity and a field", "[sim]") {
   const auto& s = sim1();
   const CorridorSimConfig c;
-  const auto& w = s.log.wheels.back();
+  const auto& w = s.log.wheels.back().ticks;
   const double m_per_tick = 2 * std::numbers::pi * c.wheel_radius_m / c.ticks_per_rev;
   const double left = 0.5 * double(w.fl + w.bl) * m_per_tick;
   const double right = 0.5 * double(w.fr + w.br) * m_per_tick;
@@ -95,9 +98,9 @@ TEST_CASE("Corridor sim: encoders count a full turn; the IMU reads gravity and a
   int n = 0;
   for (const auto& m : s.log.imu) {
     if (t_of(c, m.t_ns) > 1.0) break;
-    az += m.accel_mps2[2];
-    gz += m.gyro_radps[2];
-    mnorm += std::hypot(m.mag_uT[0], m.mag_uT[1], m.mag_uT[2]);
+    az += m.accel_mps2.z();
+    gz += m.gyro_radps.z();
+    mnorm += m.mag_uT.norm();
     ++n;
   }
   CHECK(az / n == Approx(9.81).margin(0.2));
@@ -123,10 +126,10 @@ TEST_CASE("Corridor sim: SLAM freezes before corner 3, is lost, and re-initialis
     if (t >= s.t_freeze_s && t < s.t_lost_s) {
       CHECK(r.state == SlamState::kTracking);
       if (frozen++ == 0) {
-        fx = r.p[0];
-        fy = r.p[1];
+        fx = r.position_m.x();
+        fy = r.position_m.y();
       }
-      CHECK(std::hypot(r.p[0] - fx, r.p[1] - fy) < 0.25);  // stuck, up to noise
+      CHECK(std::hypot(r.position_m.x() - fx, r.position_m.y() - fy) < 0.25);  // stuck, up to noise
     }
     if (t >= s.t_reinit_s) CHECK(r.state != SlamState::kLost);
   }
@@ -137,8 +140,7 @@ TEST_CASE("Corridor sim: SLAM freezes before corner 3, is lost, and re-initialis
   const auto it = std::find_if(s.log.slam.begin(), s.log.slam.end(),
                                [](const auto& r) { return r.state == SlamState::kReinit; });
   REQUIRE(it != s.log.slam.end());
-  const double q = std::hypot(it->q[0], it->q[1], it->q[2]);
-  CHECK(std::hypot(q, it->q[3]) == Approx(1.0));
+  CHECK(it->orientation.norm() == Approx(1.0));
 }
 
 TEST_CASE("Corridor sim: an invalid config is rejected, naming the field", "[sim]") {
@@ -176,4 +178,15 @@ TEST_CASE("Corridor sim: an invalid config is rejected, naming the field", "[sim
   edge.jitter_s = 0.0049;  // just under half of the IMU's 10 ms
   const auto s = simulate_corridor(edge, 1);
   for (std::size_t i = 1; i < s.log.imu.size(); ++i) REQUIRE(s.log.imu[i].t_ns > s.log.imu[i - 1].t_ns);
+}
+
+TEST_CASE("Corridor sim: a clock origin too close to the end of int64 is rejected", "[sim][overflow]") {
+  CorridorSimConfig c;
+  c.t0_ns = std::numeric_limits<std::int64_t>::max() - 1'000'000'000;  // 1 s before the end
+  CHECK_THROWS_AS(simulate_corridor(c, 1), posefuse::invalid_argument);
+  CHECK_THROWS_WITH(simulate_corridor(c, 1), Catch::Contains("does not fit in int64 nanoseconds"));
+  c.t0_ns = std::numeric_limits<std::int64_t>::min();  // the start of the range is fine
+  const auto s = simulate_corridor(c, 1);
+  CHECK(s.log.wheels.front().t_ns >= c.t0_ns);
+  CHECK(posefuse::seconds_between(s.log.wheels.back().t_ns, c.t0_ns) == Approx(s.duration_s).margin(0.05));
 }

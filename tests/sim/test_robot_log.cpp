@@ -5,12 +5,15 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <string>
+#include <vector>
 #include <unistd.h>
 #include <posefuse/io/robot_log.hpp>
-#include <posefuse/sim/corridor.hpp>
+#include <apps/sim/corridor.hpp>
 
 namespace fs = std::filesystem;
 
@@ -79,12 +82,13 @@ TEST_CASE("RobotLog: a minimal log reads back with every field", "[sim][io][robo
   CHECK(log.params.ticks_per_rev == 1320);
   CHECK(log.params.track_width_m == 0.4);
   REQUIRE(log.wheels.size() == 3);
-  CHECK(log.wheels[2].fr == 12);
+  CHECK(log.wheels[2].ticks.fr == 12);
   REQUIRE(log.imu.size() == 1);
-  CHECK(log.imu[0].mag_uT[2] == -40);
+  CHECK(log.imu[0].mag_uT.z() == -40);
   REQUIRE(log.slam.size() == 2);
   CHECK(log.slam[0].state == posefuse::SlamState::kLost);
-  CHECK(log.slam[1].p[0] == 0.1);
+  CHECK(log.slam[1].position_m.x() == 0.1);
+  CHECK(log.slam[1].orientation.w() == 1.0);
   CHECK(log.groundtruth.empty());
 }
 
@@ -118,7 +122,8 @@ TEST_CASE("RobotLog: liberal about headers, spaces, CRLF, case and lost rows", "
   REQUIRE(log.slam.size() == 4);
   CHECK(log.slam[2].state == posefuse::SlamState::kTracking);
   CHECK(log.slam[3].state == posefuse::SlamState::kReinit);
-  CHECK(log.slam[3].p[0] == 5.0);
+  CHECK(log.slam[3].position_m.x() == 5.0);
+  CHECK(log.slam[3].orientation.z() == 0.7071068);  // the file's column order is x, y, z, w
 }
 
 TEST_CASE("RobotLog: malformed files name file and line", "[sim][io][robot_log]") {
@@ -239,27 +244,53 @@ TEST_CASE("RobotLog: doubtful encoders and ground truth give warnings", "[sim][i
   };
   {  // The left side counts backwards: the path spins instead of driving.
     auto log = sim.log;
-    for (auto& r : log.wheels) r.fl = -r.fl, r.bl = -r.bl;
+    for (auto& r : log.wheels) r.ticks.fl = -r.ticks.fl, r.ticks.bl = -r.ticks.bl;
     const auto w = posefuse::check_robot_log(log);
     CHECK(warned(w, "wheels.csv: the encoder path turns"));
     CHECK(warned(w, "does one side count backwards"));
   }
   {  // One wheel counts backwards.
     auto log = sim.log;
-    for (auto& r : log.wheels) r.br = -r.br;
+    for (auto& r : log.wheels) r.ticks.br = -r.ticks.br;
     CHECK(warned(posefuse::check_robot_log(log), "wheels.csv: the right wheels disagree"));
   }
   {  // Every wheel counts backwards.
     auto log = sim.log;
-    for (auto& r : log.wheels) r.fl = -r.fl, r.fr = -r.fr, r.bl = -r.bl, r.br = -r.br;
+    for (auto& r : log.wheels)
+      r.ticks = {-r.ticks.fl, -r.ticks.fr, -r.ticks.bl, -r.ticks.br};
     CHECK(warned(posefuse::check_robot_log(log), "wheels.csv: the encoder path runs mostly backwards"));
   }
   {  // Ground truth in another frame.
     auto log = sim.log;
-    for (auto& g : log.groundtruth) g.x += 2.0;
+    for (auto& g : log.groundtruth) g.pose.x() += 2.0;
     CHECK(warned(posefuse::check_robot_log(log, "d"), "groundtruth.csv: the first pose is (2.00 m"));
     log = sim.log;
-    for (auto& g : log.groundtruth) g.yaw += 0.2;
+    for (auto& g : log.groundtruth) g.pose(2) += 0.2;
     CHECK(warned(posefuse::check_robot_log(log), "ground truth in the odometry frame"));
   }
+}
+
+TEST_CASE("RobotLog: checks of counters and stamps at the ends of the int64 range do not overflow",
+          "[sim][io][robot_log][overflow]") {
+  constexpr std::int64_t lo = std::numeric_limits<std::int64_t>::min();
+  constexpr std::int64_t hi = std::numeric_limits<std::int64_t>::max();
+  const posefuse::RobotLogParams p{1320, 0.065, 0.4, 0.98, 0.01};
+  // Regression: these tick and stamp differences overflowed int64 (undefined behaviour).
+  const std::vector<posefuse::WheelSample> wrap{{0, {lo, 0, 0, 0}}, {100'000'000, {hi, 0, 0, 0}}};
+  CHECK_THROWS_WITH(posefuse::check_wheel_increments(wrap, p, "wheels.csv"),
+                    Catch::Contains("fl jumps from " + std::to_string(lo) + " to " +
+                                    std::to_string(hi) + " ticks in 0.1000 s"));
+  const std::vector<posefuse::WheelSample> far{{lo + 1, {0, 0, 0, 0}}, {hi, {10, 10, 10, 10}}};
+  CHECK_NOTHROW(posefuse::check_wheel_increments(far, p, "wheels.csv"));  // 10 ticks in 585 years
+  // The path warnings on the wrapped counter: finite numbers, the left side disagreeing.
+  const auto w = posefuse::wheel_path_warnings(wrap, p, "wheels.csv");
+  CHECK(std::any_of(w.begin(), w.end(), [](const std::string& s) {
+    return s.find("wheels.csv: the left wheels disagree") != std::string::npos &&
+           s.find("nan") == std::string::npos && s.find("inf") == std::string::npos;
+  }));
+  // Counters near the ends that move normally raise nothing.
+  std::vector<posefuse::WheelSample> near_end;
+  for (std::int64_t k = 0; k < 100; ++k)
+    near_end.push_back({k * 20'000'000, {hi - 1000 + k, hi - 1000 + k, lo + k, lo + k}});
+  CHECK_NOTHROW(posefuse::check_wheel_increments(near_end, p, "wheels.csv"));
 }

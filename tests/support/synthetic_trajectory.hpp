@@ -12,7 +12,7 @@
 #include <cstddef>
 #include <random>
 
-#include <posefuse/io/trajectory.hpp>
+#include <posefuse/core/trajectory.hpp>
 
 namespace posefuse::test {
 

@@ -40,16 +40,21 @@
 /// Every run with the same config and seed gives the same log (mt19937_64 and
 /// a portable Box-Muller; no std::normal_distribution).
 
+#include <Eigen/Core>
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <numbers>
 #include <random>
+#include <string>
 #include <vector>
 
 #include <posefuse/core/angles.hpp>
+#include <posefuse/core/error.hpp>
+#include <posefuse/core/samples.hpp>
 #include <posefuse/io/robot_log.hpp>
-#include <posefuse/sim/corridor_config.hpp>
+#include <apps/sim/corridor_config.hpp>
 
 namespace posefuse {
 
@@ -176,8 +181,15 @@ inline std::vector<double> sample_times(double rate_hz, double phase_s, double j
   return t;
 }
 
+/// The stamp t0_ns + t_s, rounded to the nanosecond.
+/// @throws posefuse::invalid_argument when it does not fit in an int64
+///         (t0_ns too close to the end of the range for the drive's duration)
 inline std::int64_t to_ns(std::int64_t t0_ns, double t_s) {
-  return t0_ns + std::int64_t(std::llround(t_s * 1e9));
+  const std::int64_t d = std::int64_t(std::llround(t_s * 1e9));  // t_s >= 0, a few minutes
+  if (t0_ns > std::numeric_limits<std::int64_t>::max() - d)
+    throw invalid_argument("CorridorSimConfig: t0_ns " + std::to_string(t0_ns) + " + " +
+                           std::to_string(t_s) + " s does not fit in int64 nanoseconds");
+  return t0_ns + d;
 }
 
 /// Unit quaternion (x, y, z, w) of ZYX Euler angles.
@@ -262,7 +274,7 @@ inline std::array<double, 4> quat_from_zyx(double yaw, double pitch, double roll
   // --- Ground truth.
   for (double tt : detail::sample_times(cfg.truth_rate_hz, 0, 0, T, rng)) {
     const auto st = truth(tt);
-    log.groundtruth.push_back({detail::to_ns(cfg.t0_ns, tt), st.x, st.y, st.yaw});
+    log.groundtruth.push_back({detail::to_ns(cfg.t0_ns, tt), Eigen::Vector3d(st.x, st.y, st.yaw)});
   }
   // --- Encoders: integrate each wheel's angle between samples (1 ms steps);
   // the increment since the previous sample slips by N(0, slip_sigma).
@@ -288,19 +300,21 @@ inline std::array<double, 4> quat_from_zyx(double yaw, double pitch, double roll
         phi[wi] += dphi[wi] * (1 + rng.normal(cfg.slip_sigma));
         ticks[wi] = std::int64_t(std::floor(phi[wi] * cfg.ticks_per_rev / (2 * kPi)));
       }
-      log.wheels.push_back({detail::to_ns(cfg.t0_ns, tt), ticks[0], ticks[1], ticks[2], ticks[3]});
+      log.wheels.push_back({detail::to_ns(cfg.t0_ns, tt), {ticks[0], ticks[1], ticks[2], ticks[3]}});
       t_prev = tt;
     }
   }
   // --- IMU: planar motion, so roll = pitch = 0 and body = Rz(yaw)^T world.
   for (double tt : detail::sample_times(cfg.imu_rate_hz, 0.001, cfg.jitter_s, T, rng)) {
     const auto st = truth(tt);
-    ImuRecord r;
+    ImuSample r;
     r.t_ns = detail::to_ns(cfg.t0_ns, tt);
     const std::array<double, 3> f{st.acc, st.v * st.w, 9.81};
-    for (std::size_t i = 0; i < 3; ++i) r.accel_mps2[i] = f[i] + ba[i] + rng.normal(cfg.accel_noise);
+    for (std::size_t i = 0; i < 3; ++i)
+      r.accel_mps2(Eigen::Index(i)) = f[i] + ba[i] + rng.normal(cfg.accel_noise);
     const std::array<double, 3> w{0, 0, st.w};
-    for (std::size_t i = 0; i < 3; ++i) r.gyro_radps[i] = w[i] + bg[i] + rng.normal(cfg.gyro_noise);
+    for (std::size_t i = 0; i < 3; ++i)
+      r.gyro_radps(Eigen::Index(i)) = w[i] + bg[i] + rng.normal(cfg.gyro_noise);
     std::array<double, 3> mw{cfg.earth_h_uT * std::cos(north), cfg.earth_h_uT * std::sin(north),
                              -cfg.earth_v_uT};
     for (const Blob& b : blobs) {
@@ -313,7 +327,7 @@ inline std::array<double, 4> quat_from_zyx(double yaw, double pitch, double roll
     for (std::size_t i = 0; i < 3; ++i) {
       double m = hard[i] + rng.normal(cfg.mag_noise_uT);
       for (std::size_t j = 0; j < 3; ++j) m += soft[i][j] * mb[j];
-      r.mag_uT[i] = m;
+      r.mag_uT(Eigen::Index(i)) = m;
     }
     log.imu.push_back(r);
   }
@@ -336,10 +350,10 @@ inline std::array<double, 4> quat_from_zyx(double yaw, double pitch, double roll
     for (std::size_t i = 0; i < 3; ++i)
       drift[i] = phi_gm * drift[i] + std::sqrt(1 - phi_gm * phi_gm) * rng.normal(sd[i]);
     t_prev = tt;
-    SlamRecord r;
+    SlamSample r;
     r.t_ns = detail::to_ns(cfg.t0_ns, tt);
     if (tt < cfg.slam_init_s || (tt >= out.t_lost_s && tt < out.t_reinit_s)) {
-      r.state = SlamState::kLost;  // pose fields stay (0, 0, 0), (0, 0, 0, 1)
+      r.state = SlamState::kLost;  // pose fields stay (0, 0, 0), identity (0, 0, 0, 1)
       log.slam.push_back(r);
       continue;
     }
@@ -359,9 +373,10 @@ inline std::array<double, 4> quat_from_zyx(double yaw, double pitch, double roll
       if (!reinit_done) r.state = SlamState::kReinit;
       reinit_done = true;
     }
-    r.p = {x, y, z};
-    r.q = detail::quat_from_zyx(wrap_angle(yaw), rng.normal(cfg.slam_sigma_yaw),
-                                rng.normal(cfg.slam_sigma_yaw));
+    r.position_m = Eigen::Vector3d(x, y, z);
+    const std::array<double, 4> q = detail::quat_from_zyx(wrap_angle(yaw), rng.normal(cfg.slam_sigma_yaw),
+                                                          rng.normal(cfg.slam_sigma_yaw));
+    r.orientation.coeffs() << q[0], q[1], q[2], q[3];  // x, y, z, w
     log.slam.push_back(r);
   }
   return out;

@@ -29,7 +29,7 @@
 #include <numbers>
 #include <posefuse/core/angles.hpp>
 #include <posefuse/core/error.hpp>
-#include <posefuse/io/trajectory.hpp>
+#include <posefuse/core/trajectory.hpp>
 #include <random>
 
 namespace posefuse::sim {

@@ -16,7 +16,7 @@
 #include <vector>
 
 #include <posefuse/core/error.hpp>
-#include <posefuse/io/trajectory.hpp>
+#include <posefuse/core/trajectory.hpp>
 
 namespace posefuse {
 
@@ -75,7 +75,11 @@ struct AlignmentResult {
 /// @throws posefuse::invalid_argument for different counts, fewer than 3
 ///         points, non-finite points, or a covariance of rank < 2 (evo's
 ///         "Degenerate covariance rank": e.g. all points identical or collinear)
-[[nodiscard]] inline AlignmentResult umeyama_alignment(std::span<const Eigen::Vector3d> x,
+// A template (with nothing to deduce) so that the 3x3 SVD is instantiated
+// only in translation units that call it: a plain inline function would be
+// compiled by every file that includes this header (compile cost, README).
+template <class Lazy = void>
+[[nodiscard]] AlignmentResult umeyama_alignment(std::span<const Eigen::Vector3d> x,
                                                        std::span<const Eigen::Vector3d> y,
                                                        bool with_scale) {
   if (x.size() != y.size()) {

@@ -20,7 +20,7 @@
 #include <posefuse/core/error.hpp>
 #include <posefuse/eval/alignment.hpp>
 #include <posefuse/eval/statistics.hpp>
-#include <posefuse/io/trajectory.hpp>
+#include <posefuse/core/trajectory.hpp>
 
 namespace posefuse {
 

@@ -21,7 +21,7 @@
 
 #include <posefuse/core/error.hpp>
 #include <posefuse/io/detail/text.hpp>
-#include <posefuse/io/trajectory.hpp>
+#include <posefuse/core/trajectory.hpp>
 
 namespace posefuse {
 
@@ -146,7 +146,7 @@ inline void check_stamps(std::span<const double> stamps, const char* which) {
                                                       double offset_est_s = 0.0) {
   ref.validate();
   est.validate();
-  const Association a = associate(ref.stamps, est.stamps, max_diff_s, offset_est_s);
+  const Association a = associate(ref.t_s, est.t_s, max_diff_s, offset_est_s);
   return {select(ref, a.ref_ids), select(est, a.est_ids)};
 }
 

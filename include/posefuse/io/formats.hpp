@@ -10,7 +10,7 @@
 #include <posefuse/core/error.hpp>
 #include <posefuse/io/kitti.hpp>
 #include <posefuse/io/read_options.hpp>
-#include <posefuse/io/trajectory.hpp>
+#include <posefuse/core/trajectory.hpp>
 #include <posefuse/io/tum.hpp>
 
 namespace posefuse {

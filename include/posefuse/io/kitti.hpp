@@ -20,7 +20,7 @@
 #include <posefuse/core/error.hpp>
 #include <posefuse/io/detail/text.hpp>
 #include <posefuse/io/read_options.hpp>
-#include <posefuse/io/trajectory.hpp>
+#include <posefuse/core/trajectory.hpp>
 
 namespace posefuse {
 
@@ -109,8 +109,8 @@ inline NumberedRows<double> read_stamp_rows(const std::filesystem::path& file) {
   Trajectory traj;
   traj.poses = std::move(rows.values);
   if (!times_file) {
-    traj.stamps.resize(traj.poses.size());
-    for (std::size_t k = 0; k < traj.stamps.size(); ++k) traj.stamps[k] = static_cast<double>(k);
+    traj.t_s.resize(traj.poses.size());
+    for (std::size_t k = 0; k < traj.t_s.size(); ++k) traj.t_s[k] = static_cast<double>(k);
     return traj;
   }
   detail::traj_io::NumberedRows<double> stamps = detail::traj_io::read_stamp_rows(*times_file);
@@ -128,7 +128,7 @@ inline NumberedRows<double> read_stamp_rows(const std::filesystem::path& file) {
                        times_file->string() + " has " + std::to_string(n_stamps) +
                        " timestamps; this is the first pose without a timestamp");
   }
-  traj.stamps = std::move(stamps.values);
+  traj.t_s = std::move(stamps.values);
   return traj;
 }
 
@@ -162,7 +162,7 @@ inline void write_kitti(const std::filesystem::path& file, const Trajectory& tra
 inline void write_kitti_times(const std::filesystem::path& file, const Trajectory& traj) {
   traj.validate();
   std::ofstream out = detail::traj_io::open_output(file);
-  for (const double t : traj.stamps) out << detail::traj_io::format_number(t) << '\n';
+  for (const double t : traj.t_s) out << detail::traj_io::format_number(t) << '\n';
   detail::traj_io::finish_output(out, file);
 }
 

@@ -1,7 +1,9 @@
 #pragma once
 /// @file
 /// The recorded-log folder of seed 001's corridor experiment (issue 3, item 7):
-/// reader and writer with file:line errors.
+/// reader and writer with file:line errors. The rows become the library's raw
+/// samples (core/samples.hpp): WheelSample, ImuSample, SlamSample and, for
+/// ground truth, PlanarPoseSample.
 ///
 /// A log is a folder holding
 ///
@@ -46,7 +48,10 @@
 #include <system_error>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include <posefuse/core/error.hpp>
+#include <posefuse/core/samples.hpp>
 #include <posefuse/io/detail/robot_log_csv.hpp>
 #include <posefuse/io/robot_log_checks.hpp>
 #include <posefuse/io/robot_log_records.hpp>
@@ -124,30 +129,30 @@ namespace posefuse {
   log.params = read_robot_params(dir / "robot.txt");
   const auto wheels_file = dir / "wheels.csv";
   std::vector<std::size_t> wheel_lines;
-  log.wheels = detail::read_csv<WheelRecord>(wheels_file, detail::kWheelCols, [](CsvLine& c) {
-    WheelRecord r;
+  log.wheels = detail::read_csv<WheelSample>(wheels_file, detail::kWheelCols, [](CsvLine& c) {
+    WheelSample r;
     r.t_ns = c.integer();
-    r.fl = c.integer();
-    r.fr = c.integer();
-    r.bl = c.integer();
-    r.br = c.integer();
+    r.ticks.fl = c.integer();
+    r.ticks.fr = c.integer();
+    r.ticks.bl = c.integer();
+    r.ticks.br = c.integer();
     return r;
   }, &wheel_lines);
   if (log.wheels.size() < 2) throw io_error(wheels_file, "needs at least two data rows");
   check_wheel_increments(log.wheels, log.params, wheels_file, wheel_lines);
   const auto imu_file = dir / "imu.csv";
-  log.imu = detail::read_csv<ImuRecord>(imu_file, detail::kImuCols, [](CsvLine& c) {
-    ImuRecord r;
+  log.imu = detail::read_csv<ImuSample>(imu_file, detail::kImuCols, [](CsvLine& c) {
+    ImuSample r;
     r.t_ns = c.integer();
-    for (double& v : r.accel_mps2) v = c.real();
-    for (double& v : r.gyro_radps) v = c.real();
-    for (double& v : r.mag_uT) v = c.real();
+    for (Eigen::Index i = 0; i < 3; ++i) r.accel_mps2(i) = c.real();
+    for (Eigen::Index i = 0; i < 3; ++i) r.gyro_radps(i) = c.real();
+    for (Eigen::Index i = 0; i < 3; ++i) r.mag_uT(i) = c.real();
     return r;
   });
   if (log.imu.empty()) throw io_error(imu_file, "has no data rows");
   const auto slam_file = dir / "slam.csv";
-  log.slam = detail::read_csv<SlamRecord>(slam_file, detail::kSlamCols, [](CsvLine& c) {
-    SlamRecord r;
+  log.slam = detail::read_csv<SlamSample>(slam_file, detail::kSlamCols, [](CsvLine& c) {
+    SlamSample r;
     r.t_ns = c.integer();
     const std::string_view s = c.text();
     const std::string st = detail::lower(s);
@@ -156,10 +161,11 @@ namespace posefuse {
     else if (st == "reinit") r.state = SlamState::kReinit;
     else c.fail("tracking, lost or reinit", s);
     const bool lost = r.state == SlamState::kLost;
-    for (double& v : r.p) v = c.real(lost);
-    for (double& v : r.q) v = c.real(lost);
+    for (Eigen::Index i = 0; i < 3; ++i) r.position_m(i) = c.real(lost);
+    auto& q = r.orientation.coeffs();  // x, y, z, w: the file's column order
+    for (Eigen::Index i = 0; i < 4; ++i) q(i) = c.real(lost);
     if (!lost) {
-      const double n2 = r.q[0] * r.q[0] + r.q[1] * r.q[1] + r.q[2] * r.q[2] + r.q[3] * r.q[3];
+      const double n2 = q(0) * q(0) + q(1) * q(1) + q(2) * q(2) + q(3) * q(3);
       if (!(std::abs(std::sqrt(n2) - 1.0) < 1e-2))
         c.error("quaternion (qx,qy,qz,qw) is not unit length (|q| = " +
                 detail::fmt(std::sqrt(n2)) + ")");
@@ -169,12 +175,10 @@ namespace posefuse {
   const auto gt_file = dir / "groundtruth.csv";
   if (std::filesystem::exists(gt_file)) {
     log.groundtruth =
-        detail::read_csv<GroundTruthRecord>(gt_file, detail::kTruthCols, [](CsvLine& c) {
-          GroundTruthRecord r;
+        detail::read_csv<PlanarPoseSample>(gt_file, detail::kTruthCols, [](CsvLine& c) {
+          PlanarPoseSample r;
           r.t_ns = c.integer();
-          r.x = c.real();
-          r.y = c.real();
-          r.yaw = c.real();
+          for (Eigen::Index i = 0; i < 3; ++i) r.pose(i) = c.real();  // x, y, yaw
           return r;
         });
   }
@@ -207,21 +211,22 @@ inline void write_robot_log(const std::filesystem::path& dir, const RobotLog& lo
   });
   write("wheels.csv", "# t_ns,fl,fr,bl,br\n", [&](std::ostream& o) {
     for (const auto& r : log.wheels)
-      o << r.t_ns << ',' << r.fl << ',' << r.fr << ',' << r.bl << ',' << r.br << '\n';
+      o << r.t_ns << ',' << r.ticks.fl << ',' << r.ticks.fr << ',' << r.ticks.bl << ','
+        << r.ticks.br << '\n';
   });
   write("imu.csv", "# t_ns,ax,ay,az,gx,gy,gz,mx,my,mz\n", [&](std::ostream& o) {
     for (const auto& r : log.imu) {
       o << r.t_ns;
-      for (const auto* a : {&r.accel_mps2, &r.gyro_radps, &r.mag_uT})
-        for (double v : *a) o << ',' << fmt(v);
+      for (const Eigen::Vector3d* a : {&r.accel_mps2, &r.gyro_radps, &r.mag_uT})
+        for (Eigen::Index i = 0; i < 3; ++i) o << ',' << fmt((*a)(i));
       o << '\n';
     }
   });
   write("slam.csv", "# t_ns,state,x,y,z,qx,qy,qz,qw\n", [&](std::ostream& o) {
     for (const auto& r : log.slam) {
       o << r.t_ns << ',' << to_string(r.state);
-      for (double v : r.p) o << ',' << fmt(v);
-      for (double v : r.q) o << ',' << fmt(v);
+      for (Eigen::Index i = 0; i < 3; ++i) o << ',' << fmt(r.position_m(i));
+      for (Eigen::Index i = 0; i < 4; ++i) o << ',' << fmt(r.orientation.coeffs()(i));  // x y z w
       o << '\n';
     }
   });
@@ -231,7 +236,7 @@ inline void write_robot_log(const std::filesystem::path& dir, const RobotLog& lo
   }
   write("groundtruth.csv", "# t_ns,x,y,yaw\n", [&](std::ostream& o) {
     for (const auto& r : log.groundtruth)
-      o << r.t_ns << ',' << fmt(r.x) << ',' << fmt(r.y) << ',' << fmt(r.yaw) << '\n';
+      o << r.t_ns << ',' << fmt(r.pose(0)) << ',' << fmt(r.pose(1)) << ',' << fmt(r.pose(2)) << '\n';
   });
 }
 

@@ -21,6 +21,10 @@
 /// turns far more than it travels, front and back wheels of one side that
 /// disagree, or a mostly backwards path (an encoder counting backwards);
 /// ground truth whose first pose is not at the odometry origin with yaw 0.
+///
+/// Every time and tick difference is computed without integer overflow
+/// (seconds_between, saturating_difference), so stamps or counters anywhere
+/// in the int64 range give messages, not undefined behaviour.
 
 #include <algorithm>
 #include <cmath>
@@ -35,6 +39,8 @@
 #include <vector>
 
 #include <posefuse/core/error.hpp>
+#include <posefuse/core/samples.hpp>
+#include <posefuse/core/time.hpp>
 #include <posefuse/io/robot_log_records.hpp>
 
 namespace posefuse {
@@ -72,18 +78,23 @@ inline double median_of(std::vector<double> v) {
 
 }  // namespace detail
 
-/// True when a SLAM pose's body z axis is more than `max_deg` from the map's z.
-[[nodiscard]] inline bool slam_pose_tilted(const SlamRecord& r, double max_deg = 20.0) noexcept {
-  const double n2 = r.q[0] * r.q[0] + r.q[1] * r.q[1] + r.q[2] * r.q[2] + r.q[3] * r.q[3];
+/// True when a SLAM pose's body z axis is more than `max_deg` from the map's z:
+/// \f$ R_{22} = 1 - 2 (q_x^2 + q_y^2) / |q|^2 < \cos(\mathrm{max\_deg}) \f$.
+/// @param[in] r the SLAM sample (its quaternion need not be normalised)
+/// @param[in] max_deg tilt limit (deg)
+/// @return true when tilted; false for a zero or NaN quaternion
+[[nodiscard]] inline bool slam_pose_tilted(const SlamSample& r, double max_deg = 20.0) noexcept {
+  const auto& q = r.orientation.coeffs();  // x, y, z, w
+  const double n2 = q(0) * q(0) + q(1) * q(1) + q(2) * q(2) + q(3) * q(3);
   if (!(n2 > 0)) return false;
-  const double cos_tilt = 1.0 - 2.0 * (r.q[0] * r.q[0] + r.q[1] * r.q[1]) / n2;  // R(2, 2)
+  const double cos_tilt = 1.0 - 2.0 * (q(0) * q(0) + q(1) * q(1)) / n2;  // R(2, 2)
   return cos_tilt < std::cos(max_deg * std::numbers::pi / 180.0);
 }
 
 /// Throws when one wheels.csv increment implies more than the speed limit.
 /// @param[in] lines 1-based line of each row (empty: "data row K" is named)
 /// @throws posefuse::io_error (file:line) naming wheel, ticks, time and speed
-inline void check_wheel_increments(const std::vector<WheelRecord>& w, const RobotLogParams& p,
+inline void check_wheel_increments(const std::vector<WheelSample>& w, const RobotLogParams& p,
                                    const std::filesystem::path& file,
                                    std::span<const std::size_t> lines = {},
                                    const RobotLogLimits& lim = {}) {
@@ -91,11 +102,13 @@ inline void check_wheel_increments(const std::vector<WheelRecord>& w, const Robo
   if (!(m_per_tick > 0) || !std::isfinite(m_per_tick)) return;  // robot.txt is checked elsewhere
   static constexpr const char* kNames[4] = {"fl", "fr", "bl", "br"};
   for (std::size_t i = 1; i < w.size(); ++i) {
-    const double dt = double(w[i].t_ns - w[i - 1].t_ns) * 1e-9;
-    const std::int64_t a[4] = {w[i - 1].fl, w[i - 1].fr, w[i - 1].bl, w[i - 1].br};
-    const std::int64_t b[4] = {w[i].fl, w[i].fr, w[i].bl, w[i].br};
+    const double dt = seconds_between(w[i].t_ns, w[i - 1].t_ns);
+    const WheelTicks& x = w[i - 1].ticks;
+    const WheelTicks& y = w[i].ticks;
+    const std::int64_t a[4] = {x.fl, x.fr, x.bl, x.br};
+    const std::int64_t b[4] = {y.fl, y.fr, y.bl, y.br};
     for (std::size_t k = 0; k < 4; ++k) {
-      const double d = std::abs(double(b[k]) - double(a[k]));
+      const double d = std::abs(double(saturating_difference(b[k], a[k])));
       const double v = std::max(0.0, d - 1.0) * m_per_tick / dt;  // one tick of quantisation
       if (!(v > lim.max_wheel_speed_mps)) continue;
       const std::string why =
@@ -113,15 +126,15 @@ inline void check_wheel_increments(const std::vector<WheelRecord>& w, const Robo
 }
 
 /// Throws unless the first rows of imu.csv read gravity as +z (REP-103).
-inline void check_imu_axes(const std::vector<ImuRecord>& imu, const std::filesystem::path& file,
+inline void check_imu_axes(const std::vector<ImuSample>& imu, const std::filesystem::path& file,
                            const RobotLogLimits& lim = {}) {
   const std::size_t n = std::min(imu.size(), lim.imu_rest_rows);
   if (n == 0) return;
   std::vector<double> ax, ay, az;
   for (std::size_t i = 0; i < n; ++i) {
-    ax.push_back(imu[i].accel_mps2[0]);
-    ay.push_back(imu[i].accel_mps2[1]);
-    az.push_back(imu[i].accel_mps2[2]);
+    ax.push_back(imu[i].accel_mps2.x());
+    ay.push_back(imu[i].accel_mps2.y());
+    az.push_back(imu[i].accel_mps2.z());
   }
   const double mx = detail::median_of(ax), my = detail::median_of(ay), mz = detail::median_of(az);
   const std::string med = "median (ax, ay, az) of the first " + std::to_string(n) + " rows is (" +
@@ -136,10 +149,10 @@ inline void check_imu_axes(const std::vector<ImuRecord>& imu, const std::filesys
 /// Counts the valid SLAM poses tilted more than the limit from z-up.
 /// @return the count; throws when it is more than half of the valid poses
 /// @throws posefuse::io_error naming the file
-inline int check_slam_tilt(const std::vector<SlamRecord>& slam, const std::filesystem::path& file,
+inline int check_slam_tilt(const std::vector<SlamSample>& slam, const std::filesystem::path& file,
                            const RobotLogLimits& lim = {}) {
   int valid = 0, tilted = 0;
-  for (const SlamRecord& r : slam) {
+  for (const SlamSample& r : slam) {
     if (r.state == SlamState::kLost) continue;
     ++valid;
     tilted += slam_pose_tilted(r, lim.max_slam_tilt_deg);
@@ -188,16 +201,23 @@ inline void check_stream_clocks(const RobotLog& log, const std::filesystem::path
 
 /// Warnings about the encoder path: turning far more than travelling, front
 /// and back wheels of a side disagreeing, driving mostly backwards.
-[[nodiscard]] inline std::vector<std::string> wheel_path_warnings(const std::vector<WheelRecord>& w,
+[[nodiscard]] inline std::vector<std::string> wheel_path_warnings(const std::vector<WheelSample>& w,
                                                                   const RobotLogParams& p,
                                                                   const std::filesystem::path& file) {
   std::vector<std::string> out;
   if (w.size() < 2 || !(p.ticks_per_rev > 0) || !(p.track_width_m > 0)) return out;
   const double m = 2 * std::numbers::pi * p.wheel_radius_m / p.ticks_per_rev;
   double sum_th = 0, sum_abs_ds = 0, sum_ds = 0;
+  // Tick differences saturate instead of overflowing; their sums are taken in
+  // double (exact for the counts of any real log, |sum| < 2^53).
+  const auto delta = [](std::int64_t now, std::int64_t before) {
+    return double(saturating_difference(now, before));
+  };
   for (std::size_t i = 1; i < w.size(); ++i) {
-    const double dl = 0.5 * m * double((w[i].fl - w[i - 1].fl) + (w[i].bl - w[i - 1].bl));
-    const double dr = 0.5 * m * double((w[i].fr - w[i - 1].fr) + (w[i].br - w[i - 1].br));
+    const WheelTicks& a = w[i - 1].ticks;
+    const WheelTicks& b = w[i].ticks;
+    const double dl = 0.5 * m * (delta(b.fl, a.fl) + delta(b.bl, a.bl));
+    const double dr = 0.5 * m * (delta(b.fr, a.fr) + delta(b.br, a.br));
     sum_ds += 0.5 * (dl + dr);
     sum_abs_ds += std::abs(0.5 * (dl + dr));
     sum_th += (dr - dl) / p.track_width_m;
@@ -211,15 +231,17 @@ inline void check_stream_clocks(const RobotLog& log, const std::filesystem::path
     out.push_back(f + "the encoder path runs mostly backwards (net " + detail::num_text(sum_ds, 2) +
                   " m of " + detail::num_text(sum_abs_ds, 2) +
                   " m): forward motion must count up on every wheel");
-  const auto side = [&](const char* name, std::int64_t front, std::int64_t back) {
-    const double a = m * double(front), b = m * double(back);
+  const auto side = [&](const char* name, double front, double back) {
+    const double a = m * front, b = m * back;
     if (std::max(std::abs(a), std::abs(b)) > 1.0 && std::abs(a - b) > 0.25 * std::max(std::abs(a), std::abs(b)))
       out.push_back(f + "the " + name + " wheels disagree (front " + detail::num_text(a, 2) +
                     " m, back " + detail::num_text(b, 2) +
                     " m net): an encoder counts backwards, is mislabelled or slips");
   };
-  side("left", w.back().fl - w.front().fl, w.back().bl - w.front().bl);
-  side("right", w.back().fr - w.front().fr, w.back().br - w.front().br);
+  const WheelTicks& first = w.front().ticks;
+  const WheelTicks& last = w.back().ticks;
+  side("left", delta(last.fl, first.fl), delta(last.bl, first.bl));
+  side("right", delta(last.fr, first.fr), delta(last.br, first.br));
   return out;
 }
 
@@ -245,13 +267,13 @@ inline void check_stream_clocks(const RobotLog& log, const std::filesystem::path
   for (auto& s : wheel_path_warnings(log.wheels, log.params, detail::log_file(dir, "wheels.csv")))
     warnings.push_back(std::move(s));
   if (!log.groundtruth.empty()) {
-    const GroundTruthRecord& g = log.groundtruth.front();
-    const double yaw = std::remainder(g.yaw, 2 * std::numbers::pi);
-    if (std::hypot(g.x, g.y) > lim.gt_origin_tol_m ||
+    const Eigen::Vector3d& g = log.groundtruth.front().pose;  // x, y, yaw
+    const double yaw = std::remainder(g(2), 2 * std::numbers::pi);
+    if (std::hypot(g(0), g(1)) > lim.gt_origin_tol_m ||
         std::abs(yaw) > lim.gt_yaw_tol_deg * std::numbers::pi / 180.0)
       warnings.push_back(detail::log_file(dir, "groundtruth.csv").string() +
-                         ": the first pose is (" + detail::num_text(g.x, 2) + " m, " +
-                         detail::num_text(g.y, 2) + " m, " +
+                         ": the first pose is (" + detail::num_text(g(0), 2) + " m, " +
+                         detail::num_text(g(1), 2) + " m, " +
                          detail::num_text(yaw * 180.0 / std::numbers::pi, 1) +
                          " deg), not the origin with yaw 0; the metrics (RMSE, yaw errors) assume "
                          "ground truth in the odometry frame (the robot's pose at its first sample)");

@@ -18,7 +18,7 @@
 #include <posefuse/core/error.hpp>
 #include <posefuse/io/detail/text.hpp>
 #include <posefuse/io/read_options.hpp>
-#include <posefuse/io/trajectory.hpp>
+#include <posefuse/core/trajectory.hpp>
 
 namespace posefuse {
 
@@ -44,11 +44,11 @@ namespace posefuse {
     const std::size_t n = reader.line_no();
     const std::vector<double> v =
         detail::traj_io::parse_row(line, 8, "TUM: t tx ty tz qx qy qz qw", file, n);
-    if (!traj.stamps.empty() && !(v[0] > traj.stamps.back())) {
+    if (!traj.t_s.empty() && !(v[0] > traj.t_s.back())) {
       throw io_error(file, n,
                      "timestamp " + detail::traj_io::format_number(v[0]) +
                          " is not greater than the previous one (" +
-                         detail::traj_io::format_number(traj.stamps.back()) + " on line " +
+                         detail::traj_io::format_number(traj.t_s.back()) + " on line " +
                          std::to_string(previous_line) + ")");
     }
     // Eigen's constructor takes (w, x, y, z); the file stores x y z w.
@@ -81,7 +81,7 @@ inline void write_tum(const std::filesystem::path& file, const Trajectory& traj)
     q.normalize();
     if (q.w() < 0.0) q.coeffs() = -q.coeffs();
     const Eigen::Vector3d p = T.translation();
-    out << detail::traj_io::format_number(traj.stamps[k]);
+    out << detail::traj_io::format_number(traj.t_s[k]);
     for (const double x : {p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), q.w()}) {
       out << ' ' << detail::traj_io::format_number(x);
     }

@@ -1,7 +1,8 @@
 #pragma once
 /// @file
 /// Roll and pitch from the accelerometer's measurement of gravity (seed 001
-/// eq 1-2), and the IMU sample type of the attitude chain.
+/// eq 1-2), and the first stage of the attitude chain (its input is the
+/// library's raw ImuSample, core/samples.hpp).
 ///
 /// Two conventions are offered:
 ///  * accelerometer_tilt() is eq 1-2 exactly as printed, in the seed's own IMU
@@ -24,12 +25,13 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <concepts>
+#include <posefuse/core/samples.hpp>
 #include <posefuse/sensors/sample_status.hpp>
 
 namespace posefuse {
 
 /// Roll and pitch (rad). For the REP-103 functions these are the ZYX Euler
-/// roll (about body x) and pitch (about body y) of core/rotation.hpp; for the
+/// roll (about body x) and pitch (about body y) of lie/rotation.hpp; for the
 /// seed's eq 1-2 they are \f$ \rho_a \f$ and \f$ \phi_a \f$.
 template <std::floating_point T = double>
 struct Tilt {
@@ -64,18 +66,10 @@ template <std::floating_point T>
           std::atan2(-a.x(), std::sqrt(a.y() * a.y() + a.z() * a.z()))};
 }
 
-/// One sample of a 9-axis IMU in the REP-103 body frame (x forward, y left, z up).
-struct ImuSample {
-  double t_s{0};                                       ///< time stamp, s (strictly increasing)
-  Eigen::Vector3d accel_mps2 = Eigen::Vector3d::Zero();  ///< specific force, m/s² (+9.81 on z at rest)
-  Eigen::Vector3d gyro_radps = Eigen::Vector3d::Zero();  ///< angular rate about x, y, z, rad/s
-  Eigen::Vector3d mag_uT = Eigen::Vector3d::Zero();      ///< magnetic field, µT
-};
-
 /// An IMU sample with a roll/pitch estimate attached (what flows between the
 /// stages of the attitude chain).
 struct TiltedImu {
-  ImuSample imu;                            ///< the raw sample
+  ImuSample imu;                            ///< the raw sample (stamp t_ns)
   Tilt<double> tilt;                        ///< roll, pitch (rad), REP-103 ZYX
   SampleStatus status{SampleStatus::kOk};  ///< kNonFinite when tilt is unusable
 };

@@ -5,7 +5,7 @@
 ///
 /// Frames and sign convention (REP-103): body frame x forward, y left, z up;
 /// world frame x toward magnetic north, y west, z up. Yaw is the ZYX Euler yaw
-/// of core/rotation.hpp: 0 when the robot faces magnetic north, increasing
+/// of lie/rotation.hpp: 0 when the robot faces magnetic north, increasing
 /// counter-clockwise seen from above (turning left). The local field in the
 /// world frame is \f$ B(\cos I, 0, -\sin I) \f$ (dip I > 0 in the northern
 /// hemisphere); only its horizontal part matters. Add the magnetic
@@ -21,6 +21,7 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <concepts>
+#include <cstdint>
 #include <posefuse/core/angles.hpp>
 #include <posefuse/sensors/accelerometer_tilt.hpp>
 #include <posefuse/sensors/magnetometer_calibration.hpp>
@@ -73,7 +74,7 @@ template <std::floating_point T>
 /// Roll, pitch and yaw of the body at one time (rad, REP-103 ZYX; yaw from
 /// magnetic north, counter-clockwise positive). Output of the attitude chain.
 struct Attitude {
-  double t_s{0};    ///< time stamp, s
+  std::int64_t t_ns{0};  ///< stamp of the IMU sample (ns)
   double roll{0};   ///< rad
   double pitch{0};  ///< rad
   double yaw{0};    ///< rad, [-pi, pi)
@@ -103,7 +104,7 @@ class CompassStage {
   /// @param[in] in IMU sample with roll/pitch (rad)
   /// @return roll, pitch from `in`, yaw from the calibrated magnetometer
   [[nodiscard]] Attitude operator()(const TiltedImu& in) noexcept {
-    Attitude out{in.imu.t_s, in.tilt.roll, in.tilt.pitch, last_yaw_, in.status};
+    Attitude out{in.imu.t_ns, in.tilt.roll, in.tilt.pitch, last_yaw_, in.status};
     const Eigen::Vector3d m = cal_.apply(in.imu.mag_uT);
     const double yaw = wrap_angle(tilt_compensated_heading(m, in.tilt.roll, in.tilt.pitch) +
                                   declination_rad_);

@@ -2,7 +2,8 @@
 /// @file
 /// Hard- and soft-iron magnetometer calibration by a least-squares ellipsoid
 /// fit (seed 001 §2: "Hard Iron, Soft Iron ... must be calibrated"; the
-/// authors used the sensor's built-in calibration).
+/// authors used the sensor's built-in calibration), and its horizontal
+/// counterpart for ground robots, which turn about z only.
 ///
 /// Model: a raw reading is \f$ m = D\,b + h \f$ for the true field b, a
 /// soft-iron matrix D and a hard-iron offset h. Over all orientations the raw
@@ -10,15 +11,39 @@
 /// calibration is \f$ \hat b = S (m - h) \f$ with the symmetric
 /// \f$ S = k\,Q^{1/2} \f$, which equals \f$ D^{-1} \f$ when D is symmetric and
 /// k is the true field magnitude (a rotation part of D is unobservable).
+///
+/// The fits are function templates over the range of readings, so that a
+/// translation unit that merely includes this header does not compile their
+/// eigen-solvers (which cost several seconds of compile time per TU).
 
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <concepts>
+#include <cstddef>
+#include <iterator>
+#include <numbers>
 #include <posefuse/core/error.hpp>
-#include <span>
+#include <ranges>
 #include <string>
+#include <type_traits>
 
 namespace posefuse {
+
+/// A range of magnetometer readings: any forward range (std::vector,
+/// std::span, a std::views::transform over ImuSample::mag_uT, ...) whose
+/// elements are fixed-size Eigen column vectors of `Dim` entries that convert
+/// to `Eigen::Matrix<double, Dim, 1>` (µT, sensor frame).
+template <class R, int Dim>
+concept MagnetometerReadings =
+    std::ranges::forward_range<R> &&
+    requires {
+      requires int(std::remove_cvref_t<std::ranges::range_reference_t<R>>::RowsAtCompileTime) == Dim;
+      requires int(std::remove_cvref_t<std::ranges::range_reference_t<R>>::ColsAtCompileTime) == 1;
+    } &&
+    std::convertible_to<std::ranges::range_reference_t<R>, Eigen::Matrix<double, Dim, 1>>;
 
 /// Hard- and soft-iron correction of a magnetometer, \f$ \hat b = S (m - h) \f$.
 struct MagnetometerCalibration {
@@ -43,7 +68,8 @@ struct MagnetometerCalibration {
 /// \f$ m^\top A m + 2 u^\top m = 1 \f$; then \f$ h = -A^{-1} u \f$ and
 /// \f$ Q = A / (1 + h^\top A h) \f$. Fixed-size 9x9 normal equations; no
 /// allocation.
-/// @param[in] samples raw readings, µT (at least 9, spread over orientations)
+/// @param[in] samples raw readings (a MagnetometerReadings range of 3-vectors),
+///            µT (at least 9, spread over orientations)
 /// @param[in] field_norm_uT magnitude the calibrated readings should have
 ///            (e.g. the local field strength); 0 keeps the geometric mean
 ///            radius of the fitted ellipsoid
@@ -51,29 +77,37 @@ struct MagnetometerCalibration {
 /// @throws posefuse::invalid_argument with fewer than 9 samples, non-finite
 ///         samples, a negative field_norm_uT, samples that do not span an
 ///         ellipsoid (e.g. all in one plane), or a fit that is not an ellipsoid
-[[nodiscard]] inline MagnetometerCalibration fit_ellipsoid(std::span<const Eigen::Vector3d> samples,
-                                                           double field_norm_uT = 0.0) {
+template <class Readings>
+  requires MagnetometerReadings<const Readings&, 3>
+[[nodiscard]] MagnetometerCalibration fit_ellipsoid(const Readings& samples,
+                                                    double field_norm_uT = 0.0) {
   using Vec9 = Eigen::Matrix<double, 9, 1>;
   using Mat9 = Eigen::Matrix<double, 9, 9>;
-  if (samples.size() < 9)
+  const auto count = std::size_t(std::ranges::distance(samples));
+  if (count < 9)
     throw invalid_argument("posefuse: fit_ellipsoid needs at least 9 samples, got " +
-                           std::to_string(samples.size()));
+                           std::to_string(count));
   if (!(std::isfinite(field_norm_uT) && field_norm_uT >= 0.0))
     throw invalid_argument("posefuse: fit_ellipsoid field_norm_uT must be finite and >= 0");
   Eigen::Vector3d c = Eigen::Vector3d::Zero();
-  for (const auto& m : samples) {
+  for (const auto& r : samples) {
+    const Eigen::Vector3d& m = r;
     if (!m.allFinite()) throw invalid_argument("posefuse: fit_ellipsoid got a non-finite sample");
     c += m;
   }
-  c /= double(samples.size());
+  c /= double(count);
   double s2 = 0.0;
-  for (const auto& m : samples) s2 += (m - c).squaredNorm();
-  const double s = std::sqrt(s2 / double(samples.size()));
+  for (const auto& r : samples) {
+    const Eigen::Vector3d& m = r;
+    s2 += (m - c).squaredNorm();
+  }
+  const double s = std::sqrt(s2 / double(count));
   if (!(s > 0.0)) throw invalid_argument("posefuse: fit_ellipsoid samples are all equal");
 
   Mat9 N = Mat9::Zero();
   Vec9 rhs = Vec9::Zero();
-  for (const auto& m : samples) {
+  for (const auto& r : samples) {
+    const Eigen::Vector3d& m = r;
     const Eigen::Vector3d p = (m - c) / s;
     Vec9 v;
     v << p.x() * p.x(), p.y() * p.y(), p.z() * p.z(), 2 * p.x() * p.y(), 2 * p.x() * p.z(),
@@ -109,6 +143,157 @@ struct MagnetometerCalibration {
   cal.hard_iron = c + s * h;
   cal.soft_iron = k * ea.eigenvectors() * q.cwiseSqrt().asDiagonal() * ea.eigenvectors().transpose();
   return cal;
+}
+
+/// Why fit_horizontal_ellipse() did or did not calibrate.
+enum class EllipseFitStatus {
+  kOk,                 ///< calibrated
+  kTooFewReadings,     ///< fewer than HorizontalEllipseFitOptions::min_readings
+  kNonFinite,          ///< a reading is NaN or infinite
+  kConstantReadings,   ///< all readings equal (no spread to fit)
+  kNotAnEllipse,       ///< the fitted conic is not an ellipse of plausible shape
+  kTooLittleTurning,   ///< the readings cover too small an arc around the centre
+};
+
+/// The reason of a status as a short phrase ("fewer than 20 readings", ...),
+/// for notes and messages.
+/// @param[in] s the status
+/// @param[in] min_readings the minimum used (for kTooFewReadings)
+/// @param[in] min_coverage_deg the coverage required (for kTooLittleTurning)
+[[nodiscard]] inline std::string to_string(EllipseFitStatus s, std::size_t min_readings = 20,
+                                           double min_coverage_deg = 270.0) {
+  switch (s) {
+    case EllipseFitStatus::kOk: return "calibrated";
+    case EllipseFitStatus::kTooFewReadings:
+      return "fewer than " + std::to_string(min_readings) + " readings";
+    case EllipseFitStatus::kNonFinite: return "a reading is not finite";
+    case EllipseFitStatus::kConstantReadings: return "constant readings";
+    case EllipseFitStatus::kNotAnEllipse: return "readings are not on a plausible ellipse";
+    case EllipseFitStatus::kTooLittleTurning:
+      return "the robot turned through less than " +
+             std::to_string(int(std::lround(min_coverage_deg))) + " deg";
+  }
+  return "unknown";
+}
+
+/// Acceptance limits of fit_horizontal_ellipse().
+struct HorizontalEllipseFitOptions {
+  std::size_t min_readings = 20;      ///< fewer readings are not fitted
+  double max_eigenvalue_ratio = 4.0;  ///< largest / smallest eigenvalue of Q (axis ratio², 4: axes 2:1)
+  double min_coverage_deg = 270.0;    ///< arc of 10° direction bins (about the centre) the readings must fill
+};
+
+/// Result of fit_horizontal_ellipse().
+struct HorizontalEllipseFit {
+  EllipseFitStatus status = EllipseFitStatus::kTooFewReadings;  ///< kOk when calibrated
+  /// The calibration: hard iron (h_x, h_y, 0), soft iron with the fitted 2x2
+  /// block and 1 for z; identity / zero unless status is kOk.
+  MagnetometerCalibration calibration;
+  double coverage_deg = 0;    ///< arc covered by the readings (10° bins about the centre)
+  std::size_t readings = 0;   ///< number of readings given
+  /// True when calibrated.
+  [[nodiscard]] bool ok() const noexcept { return status == EllipseFitStatus::kOk; }
+};
+
+/// Horizontal hard- and soft-iron calibration for a robot that only turns
+/// about its z axis (a ground robot): the 3-D ellipsoid of fit_ellipsoid()
+/// is then undetermined, but the horizontal components \f$ (m_x, m_y) \f$
+/// of the readings lie on an ellipse, \f$ (m - h)^\top Q (m - h) = 1 \f$.
+///
+/// On readings centred at their mean c and scaled by their RMS spread s
+/// (conditioning), solves the algebraic least-squares conic
+/// \f$ \min_\beta \sum_i (v_i^\top\beta - 1)^2 \f$,
+/// \f$ v = (x^2, xy, y^2, x, y) \f$, i.e. \f$ a x^2 + b xy + c y^2 + d x + e y = 1 \f$
+/// (Fitzgibbon, Pilu, Fisher, "Direct least square fitting of ellipses",
+/// IEEE TPAMI 21(5), 1999, eq 1, with the constant term fixed instead of
+/// their ellipse constraint, hence the shape check). With
+/// \f$ M = \begin{pmatrix} a & b/2 \\ b/2 & c \end{pmatrix} \f$ the centre is
+/// \f$ x_0 = -\tfrac12 M^{-1} (d, e)^\top \f$ and
+/// \f$ Q = M / (1 + x_0^\top M x_0) \f$; the calibration is
+/// \f$ h = c + s\,x_0 \f$ and \f$ S = k\,Q^{1/2} \f$ with k keeping the
+/// geometric-mean radius (\f$ k = (\lambda_1\lambda_2)^{-1/4} \f$ in the
+/// scaled units: S maps the ellipse onto a circle of that radius, so headings
+/// are corrected and magnitudes stay those of the scaled readings). z is
+/// left uncalibrated (hard iron 0, scale 1).
+///
+/// The fit is accepted when it is an ellipse (both eigenvalues of Q
+/// positive) of plausible shape (eigenvalue ratio at most
+/// `max_eigenvalue_ratio`) and the readings' directions about the fitted
+/// centre fill at least `min_coverage_deg` of 36 bins of 10° — the robot
+/// turned far enough for the ellipse to be determined.
+/// @param[in] readings horizontal readings (m_x, m_y) in µT, a
+///            MagnetometerReadings range of 2-vectors (e.g. a transform view
+///            of ImuSample::mag_uT's head<2>())
+/// @param[in] options acceptance limits
+/// @return the status, the calibration (identity unless kOk), the coverage
+///         and the number of readings; never throws for bad data
+template <class Readings>
+  requires MagnetometerReadings<const Readings&, 2>
+[[nodiscard]] HorizontalEllipseFit fit_horizontal_ellipse(
+    const Readings& readings, const HorizontalEllipseFitOptions& options = {}) {
+  HorizontalEllipseFit out;
+  out.readings = std::size_t(std::ranges::distance(readings));
+  const auto fail = [&out](EllipseFitStatus why) {
+    out.status = why;
+    out.calibration = {};
+    return out;
+  };
+  if (out.readings < options.min_readings || out.readings == 0)
+    return fail(EllipseFitStatus::kTooFewReadings);
+  const double n = double(out.readings);
+  Eigen::Vector2d c = Eigen::Vector2d::Zero();
+  for (const auto& r : readings) {
+    const Eigen::Vector2d& m = r;
+    if (!m.allFinite()) return fail(EllipseFitStatus::kNonFinite);
+    c += m;
+  }
+  c /= n;
+  double s = 0;
+  for (const auto& r : readings) {
+    const Eigen::Vector2d& m = r;
+    s += (m - c).squaredNorm();
+  }
+  s = std::sqrt(s / n);
+  if (!(s > 0)) return fail(EllipseFitStatus::kConstantReadings);
+  Eigen::Matrix<double, 5, 5> N = Eigen::Matrix<double, 5, 5>::Zero();
+  Eigen::Matrix<double, 5, 1> rhs = Eigen::Matrix<double, 5, 1>::Zero();
+  for (const auto& r : readings) {
+    const Eigen::Vector2d& m = r;
+    const Eigen::Vector2d p = (m - c) / s;
+    const Eigen::Matrix<double, 5, 1> v(p.x() * p.x(), p.x() * p.y(), p.y() * p.y(), p.x(), p.y());
+    N += v * v.transpose();
+    rhs += v;
+  }
+  const Eigen::Matrix<double, 5, 1> b = N.ldlt().solve(rhs);
+  Eigen::Matrix2d M;
+  M << b(0), b(1) / 2, b(1) / 2, b(2);
+  const double det = M(0, 0) * M(1, 1) - M(0, 1) * M(1, 0);
+  const Eigen::Vector2d ctr =
+      -0.5 * Eigen::Vector2d(M(1, 1) * b(3) - M(0, 1) * b(4), M(0, 0) * b(4) - M(1, 0) * b(3)) / det;
+  const Eigen::Matrix2d Q = M / (1.0 + ctr.dot(M * ctr));
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es;
+  es.computeDirect(Q);
+  const Eigen::Vector2d ev = es.eigenvalues();
+  if (!b.allFinite() || !(ev.minCoeff() > 0) ||
+      !(ev.maxCoeff() / ev.minCoeff() <= options.max_eigenvalue_ratio))
+    return fail(EllipseFitStatus::kNotAnEllipse);
+  std::array<bool, 36> seen{};  // 10° bins of the reading's direction about the centre
+  for (const auto& r : readings) {
+    const Eigen::Vector2d& m = r;
+    const Eigen::Vector2d p = (m - c) / s - ctr;
+    const double a = std::atan2(p.y(), p.x()) + std::numbers::pi;
+    seen[std::size_t(std::min(35.0, a / (2 * std::numbers::pi) * 36))] = true;
+  }
+  out.coverage_deg = 10.0 * double(std::count(seen.begin(), seen.end(), true));
+  if (out.coverage_deg < options.min_coverage_deg) return fail(EllipseFitStatus::kTooLittleTurning);
+  const double k = 1.0 / std::sqrt(std::sqrt(ev.prod()));  // keep the geometric-mean radius
+  const Eigen::Matrix2d S = k * es.eigenvectors() * ev.cwiseSqrt().asDiagonal() *
+                            es.eigenvectors().transpose();
+  out.calibration.hard_iron << c + s * ctr, 0.0;
+  out.calibration.soft_iron.setIdentity();
+  out.calibration.soft_iron.topLeftCorner<2, 2>() = S;
+  out.status = EllipseFitStatus::kOk;
+  return out;
 }
 
 }  // namespace posefuse

@@ -5,8 +5,13 @@
 ///  * attitude: ImuSample -> AccelerometerTiltStage (eq 1-2, REP-103 form)
 ///    -> ComplementaryTiltStage (eq 3-4) -> CompassStage (eq 5-7, corrected)
 ///    -> Attitude;
-///  * odometry: StampedWheelTicks -> FourWheelAverage (eq 8)
-///    -> DiffDriveOdometry (eq 9) -> DeadReckoning (eq 10) -> PoseWithCovariance.
+///  * odometry: WheelSample -> FourWheelAverage (eq 8)
+///    -> DiffDriveOdometry (eq 9) -> DeadReckoning (eq 10) -> PlanarPoseEstimate.
+///
+/// Both start from the library's raw samples (core/samples.hpp, stamped
+/// `t_ns`) and compute every step length from stamp differences with
+/// seconds_between (core/time.hpp), so they run on stamps anywhere in the
+/// int64 range.
 ///
 /// Both are posefuse::Pipeline types (core/pipeline.hpp): every call is
 /// inlined, no allocation, no virtual dispatch; stages are reachable with
@@ -18,6 +23,7 @@
 #include <cstdint>
 #include <limits>
 #include <posefuse/core/pipeline.hpp>
+#include <posefuse/core/time.hpp>
 #include <posefuse/filters/complementary.hpp>
 #include <posefuse/models/planar_pose.hpp>
 #include <posefuse/models/unicycle.hpp>
@@ -41,7 +47,9 @@ enum class GyroToTiltRate : std::uint8_t {
 };
 
 /// Attitude-chain stage 2: complementary filter on roll and pitch (seed 001
-/// eq 3-4) with \f$ \Delta t \f$ from the sample stamps. Input and Output
+/// eq 3-4) with \f$ \Delta t \f$ from the sample stamps: the filter runs on
+/// the time since the stage's first sample, seconds_between(t_ns, first
+/// t_ns), so its steps are stamp differences in seconds. Input and Output
 /// TiltedImu; the output's tilt is the filtered estimate. The first sample
 /// initialises from the accelerometer (status kFirst); a sample whose tilt is
 /// not usable (status kNonFinite or a non-finite gyro) leaves the filter
@@ -57,8 +65,10 @@ class ComplementaryTiltStage {
   explicit ComplementaryTiltStage(double alpha, GyroToTiltRate mapping = GyroToTiltRate::kSeed)
       : filter_(alpha), mapping_(mapping) {}
 
-  /// @throws posefuse::invalid_argument if the stamp is not finite or not increasing
+  /// @throws posefuse::invalid_argument if the stamp is not later than the
+  ///         previous accepted one
   [[nodiscard]] TiltedImu operator()(const TiltedImu& in) {
+    if (!filter_.initialised()) t0_ns_ = in.imu.t_ns;
     TiltedImu out = in;
     const Eigen::Vector2d absolute(in.tilt.roll, in.tilt.pitch);
     const Eigen::Vector3d& g = in.imu.gyro_radps;
@@ -70,7 +80,8 @@ class ComplementaryTiltStage {
     }
     const Eigen::Vector2d bad = Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
     const ComplementaryStatus st =
-        filter_.update(in.imu.t_s, rate, in.status == SampleStatus::kNonFinite ? bad : absolute);
+        filter_.update(seconds_between(in.imu.t_ns, t0_ns_), rate,
+                       in.status == SampleStatus::kNonFinite ? bad : absolute);
     out.tilt = {filter_.estimate()(0), filter_.estimate()(1)};
     out.status = st == ComplementaryStatus::kNonFinite  ? SampleStatus::kNonFinite
                  : st == ComplementaryStatus::kInitialised ? SampleStatus::kFirst
@@ -78,14 +89,17 @@ class ComplementaryTiltStage {
     return out;
   }
 
-  /// The underlying filter (estimate, alpha, last stamp).
+  /// The underlying filter (estimate, alpha; its time is seconds since first_stamp_ns()).
   [[nodiscard]] const ComplementaryFilter<double, 2>& filter() const noexcept { return filter_; }
+  /// Stamp of the sample that initialised the filter (ns; meaningful once it is initialised).
+  [[nodiscard]] std::int64_t first_stamp_ns() const noexcept { return t0_ns_; }
   /// Forgets the estimate; the next sample initialises again.
   void reset() noexcept { filter_.reset(); }
 
  private:
   ComplementaryFilter<double, 2> filter_;
   GyroToTiltRate mapping_;
+  std::int64_t t0_ns_{0};
 };
 
 /// Configuration of the attitude chain.
@@ -108,7 +122,7 @@ using AttitudePipeline = Pipeline<AccelerometerTiltStage, ComplementaryTiltStage
                           CompassStage(config.calibration, config.declination_rad));
 }
 
-/// StampedWheelTicks -> PoseWithCovariance (seed 001 eq 8-10).
+/// WheelSample -> PlanarPoseEstimate (seed 001 eq 8-10).
 using OdometryPipeline = Pipeline<FourWheelAverage, DiffDriveOdometry, DeadReckoning>;
 
 /// Builds the odometry chain; `stage<2>()` is the DeadReckoning (for reset()).
@@ -116,12 +130,14 @@ using OdometryPipeline = Pipeline<FourWheelAverage, DiffDriveOdometry, DeadRecko
 /// @param[in] noise per-wheel encoder noise
 /// @param[in] method kEuler (eq 10 as printed) or kExactArc
 /// @param[in] start initial pose, world frame
-/// @param[in] cov0 initial pose covariance
+/// @param[in] cov0 initial pose covariance (3x3; a template only so that
+///            including this header does not compile DeadReckoning's check)
 /// @throws posefuse::invalid_argument for invalid params, noise, start or cov0
-[[nodiscard]] inline OdometryPipeline make_odometry_pipeline(
+template <class Cov = Eigen::Matrix3d>
+[[nodiscard]] OdometryPipeline make_odometry_pipeline(
     const DiffDriveParams& params, const WheelNoiseParams& noise = {},
     Integration method = Integration::kExactArc, const PlanarPose<double>& start = {},
-    const Eigen::Matrix3d& cov0 = Eigen::Matrix3d::Zero()) {
+    const Cov& cov0 = Cov::Zero()) {
   return OdometryPipeline(FourWheelAverage{}, DiffDriveOdometry(params, noise),
                           DeadReckoning(method, start, cov0));
 }

@@ -9,6 +9,11 @@
 /// Eq 9 prints \f$ v = r(\Delta E_R + \Delta E_L)/2 \f$ and calls r the wheel
 /// *diameter*; with increments in radians r must be the **radius** (SPEC B).
 /// Body frame REP-103 (x forward, y left); a positive turn is counter-clockwise.
+///
+/// The chain's input is the library's raw WheelSample (core/samples.hpp):
+/// cumulative counts stamped `t_ns`; step lengths `dt_s` are computed from
+/// stamp differences with seconds_between (core/time.hpp), which cannot
+/// overflow.
 
 #include <Eigen/Core>
 #include <cmath>
@@ -16,29 +21,21 @@
 #include <cstdint>
 #include <numbers>
 #include <posefuse/core/error.hpp>
+#include <posefuse/core/samples.hpp>
+#include <posefuse/core/time.hpp>
 #include <posefuse/sensors/sample_status.hpp>
 #include <string>
 
 namespace posefuse {
 
-/// Cumulative encoder counts of a four-wheel robot (ticks; front/back, left/right).
-struct WheelTicks {
-  std::int64_t fl{0};  ///< front left
-  std::int64_t fr{0};  ///< front right
-  std::int64_t bl{0};  ///< back left
-  std::int64_t br{0};  ///< back right
-};
-
-/// Per-wheel increment `now - before` (ticks).
+/// Per-wheel increment `now - before` (ticks), each saturated to the int64
+/// range instead of overflowing (saturating_difference, core/samples.hpp).
+/// @param[in] now, before cumulative counts (ticks)
+/// @return the four increments (ticks)
 [[nodiscard]] constexpr WheelTicks tick_increment(const WheelTicks& now, const WheelTicks& before) noexcept {
-  return {now.fl - before.fl, now.fr - before.fr, now.bl - before.bl, now.br - before.br};
+  return {saturating_difference(now.fl, before.fl), saturating_difference(now.fr, before.fr),
+          saturating_difference(now.bl, before.bl), saturating_difference(now.br, before.br)};
 }
-
-/// Encoder counts stamped with their time.
-struct StampedWheelTicks {
-  double t_s{0};     ///< time stamp, s (strictly increasing)
-  WheelTicks ticks;  ///< cumulative counts
-};
 
 /// Geometry of a differential-drive robot.
 struct DiffDriveParams {
@@ -169,29 +166,30 @@ struct BodyMotion {
   double dtheta_rad{0};  ///< heading change \f$ w \Delta t \f$, rad
   double v_mps{0};       ///< eq 9-a, m/s (0 when dt_s is 0)
   double w_radps{0};     ///< eq 9-b, rad/s (0 when dt_s is 0)
-  double t_s{0};         ///< time stamp of the end of the step, s
+  std::int64_t t_ns{0};  ///< stamp of the end of the step (ns)
   Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();  ///< covariance of (ds_m, dtheta_rad)
   SampleStatus status{SampleStatus::kOk};          ///< kFirst for the first sample
 };
 
 /// Left/right encoder values stamped with their time.
 struct StampedSideTicks {
-  double t_s{0};                ///< time stamp, s
+  std::int64_t t_ns{0};         ///< stamp (ns)
   SideTicks<double> ticks;      ///< cumulative E_L, E_R, ticks
 };
 
 /// Odometry-chain stage 1 (eq 8): four wheels -> two sides. Stateless.
 struct FourWheelAverage {
-  using Input = StampedWheelTicks;
+  using Input = WheelSample;
   using Output = StampedSideTicks;
   /// @return the stamp and average_sides(in.ticks)
-  [[nodiscard]] StampedSideTicks operator()(const StampedWheelTicks& in) const noexcept {
-    return {in.t_s, average_sides<double>(in.ticks)};
+  [[nodiscard]] StampedSideTicks operator()(const WheelSample& in) const noexcept {
+    return {in.t_ns, average_sides<double>(in.ticks)};
   }
 };
 
 /// Odometry-chain stage 2 (eq 9): successive side counts -> body motion with
-/// covariance. The first sample yields a zero motion with dt_s = 0 and status kFirst.
+/// covariance, \f$ \Delta t \f$ = seconds_between(t_ns, previous t_ns). The
+/// first sample yields a zero motion with dt_s = 0 and status kFirst.
 class DiffDriveOdometry {
  public:
   using Input = StampedSideTicks;
@@ -204,27 +202,28 @@ class DiffDriveOdometry {
     noise_.validate();
   }
 
-  /// @param[in] in cumulative side counts at time in.t_s
+  /// @param[in] in cumulative side counts at time in.t_ns
   /// @return motion since the previous sample
-  /// @throws posefuse::invalid_argument if the time stamp is not finite, or not
-  ///         greater than the previous one (state untouched)
+  /// @throws posefuse::invalid_argument if a count is not finite, or the stamp
+  ///         is not greater than the previous one (state untouched)
   [[nodiscard]] BodyMotion operator()(const StampedSideTicks& in) {
-    if (!std::isfinite(in.t_s) || !std::isfinite(in.ticks.left) || !std::isfinite(in.ticks.right))
-      throw invalid_argument("posefuse: DiffDriveOdometry got a non-finite time stamp or count");
+    if (!std::isfinite(in.ticks.left) || !std::isfinite(in.ticks.right))
+      throw invalid_argument("posefuse: DiffDriveOdometry got a non-finite count");
     BodyMotion out;
-    out.t_s = in.t_s;
+    out.t_ns = in.t_ns;
     if (!has_prev_) {
       prev_ = in;
       has_prev_ = true;
       out.status = SampleStatus::kFirst;
       return out;
     }
-    if (!(in.t_s > prev_.t_s))
+    if (!(in.t_ns > prev_.t_ns))
       throw invalid_argument("posefuse: DiffDriveOdometry time stamps must increase strictly (got " +
-                             std::to_string(in.t_s) + " after " + std::to_string(prev_.t_s) + ")");
+                             std::to_string(in.t_ns) + " ns after " + std::to_string(prev_.t_ns) +
+                             " ns)");
     const SideTicks<double> delta{in.ticks.left - prev_.ticks.left, in.ticks.right - prev_.ticks.right};
     const BodyDisplacement<double> d = body_displacement(delta, params_);
-    out.dt_s = in.t_s - prev_.t_s;
+    out.dt_s = seconds_between(in.t_ns, prev_.t_ns);
     out.ds_m = d.ds_m;
     out.dtheta_rad = d.dtheta_rad;
     out.v_mps = d.ds_m / out.dt_s;
@@ -249,19 +248,19 @@ class DiffDriveOdometry {
 };
 
 /// Eq 8 and 9 in one stage: four cumulative wheel counts -> body motion.
-/// Input StampedWheelTicks, Output BodyMotion (the first sample yields a zero
+/// Input WheelSample, Output BodyMotion (the first sample yields a zero
 /// motion with dt_s = 0 and status kFirst).
 class WheelOdometry {
  public:
-  using Input = StampedWheelTicks;
+  using Input = WheelSample;
   using Output = BodyMotion;
 
   /// @throws posefuse::invalid_argument if params or noise is invalid
   explicit WheelOdometry(const DiffDriveParams& params, const WheelNoiseParams& noise = {})
       : diff_(params, noise) {}
 
-  /// @throws posefuse::invalid_argument on a non-finite or non-increasing time stamp
-  [[nodiscard]] BodyMotion operator()(const StampedWheelTicks& in) { return diff_(average_(in)); }
+  /// @throws posefuse::invalid_argument on a non-increasing time stamp
+  [[nodiscard]] BodyMotion operator()(const WheelSample& in) { return diff_(average_(in)); }
 
   /// Forgets the previous sample.
   void reset() noexcept { diff_.reset(); }

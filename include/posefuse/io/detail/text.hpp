@@ -158,7 +158,10 @@ inline constexpr double kExactlyOrthonormal = 1e-12;
 /// rotation \f$ U V^\top \f$ (from \f$ R = U \Sigma V^\top \f$), or `R`
 /// itself when it is orthonormal to `kExactlyOrthonormal`.
 /// @throws posefuse::io_error for a non-orthonormal matrix or a reflection
-[[nodiscard]] inline Eigen::Matrix3d checked_rotation(const Eigen::Matrix3d& R, double tolerance,
+// A template with nothing to deduce, so that the SVD is compiled only where
+// a reader is used, not in every file including an io/ header.
+template <class Lazy = void>
+[[nodiscard]] Eigen::Matrix3d checked_rotation(const Eigen::Matrix3d& R, double tolerance,
                                                       const std::filesystem::path& file,
                                                       std::size_t line) {
   const double residual = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();

@@ -1,0 +1,116 @@
+// The library's one-way layering (DESIGN.md): a header under
+// include/posefuse/<folder>/ may include headers of its own folder and of
+// folders of a lower rank, never of a higher rank and never of a sibling of
+// the same rank. This test reads every header and fails on any arrow that
+// runs up or sideways, naming the file and line.
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// Rank of each folder of include/posefuse/. Equal ranks are siblings.
+const std::map<std::string, int>& ranks() {
+  static const std::map<std::string, int> r{
+      {"core", 0},                                           // Eigen and the standard library only
+      {"lie", 1},                                            // SO2 SE2 SO3 SE3
+      {"models", 2}, {"io", 2}, {"eval", 2}, {"testing", 2},  // siblings: none includes another
+      {"filters", 3},                                        // estimators over models
+      {"sensors", 4},                                        // raw samples -> model inputs (may run filters)
+      {"fusion", 5}, {"inertial", 5}, {"graph", 5},           // top layer
+  };
+  return r;
+}
+
+struct Arrow {
+  std::string file;
+  int line;
+  std::string from, to;
+};
+
+fs::path include_root() { return fs::path(POSEFUSE_SOURCE_DIR) / "include" / "posefuse"; }
+
+// Folder of a header relative to include/posefuse ("" for the umbrella).
+std::string folder_of(const fs::path& rel) {
+  return rel.has_parent_path() ? rel.begin()->string() : std::string();
+}
+
+std::vector<Arrow> arrows_breaking_layers(std::vector<std::string>& unknown_folders) {
+  std::vector<Arrow> bad;
+  const std::regex include_re(R"(^\s*#\s*include\s*<posefuse/([a-z_]+)/)");
+  for (const auto& entry : fs::recursive_directory_iterator(include_root())) {
+    if (!entry.is_regular_file() || entry.path().extension() != ".hpp") continue;
+    const fs::path rel = fs::relative(entry.path(), include_root());
+    const std::string from = folder_of(rel);
+    if (from.empty()) continue;  // posefuse.hpp includes everything by design
+    if (!ranks().count(from)) {
+      unknown_folders.push_back(from);
+      continue;
+    }
+    std::ifstream in(entry.path());
+    std::string text;
+    int line_no = 0;
+    while (std::getline(in, text)) {
+      ++line_no;
+      std::smatch m;
+      if (!std::regex_search(text, m, include_re)) continue;
+      const std::string to = m[1].str();
+      if (to == from) continue;
+      const auto it = ranks().find(to);
+      if (it == ranks().end()) {
+        unknown_folders.push_back(to);
+        continue;
+      }
+      if (it->second >= ranks().at(from)) bad.push_back({rel.string(), line_no, from, to});
+    }
+  }
+  return bad;
+}
+
+}  // namespace
+
+TEST_CASE("Layering: no header includes a layer above it or a sibling", "[core][layering]") {
+  REQUIRE(fs::is_directory(include_root()));
+  std::vector<std::string> unknown;
+  const std::vector<Arrow> bad = arrows_breaking_layers(unknown);
+  for (const Arrow& a : bad)
+    UNSCOPED_INFO(a.file << ":" << a.line << ": " << a.from << " (rank " << ranks().at(a.from)
+                         << ") includes " << a.to << " (rank " << ranks().at(a.to) << ")");
+  CHECK(bad.empty());
+  // A new folder must be given a rank here before it can be used.
+  for (const std::string& f : unknown) UNSCOPED_INFO("folder without a rank: " << f);
+  CHECK(unknown.empty());
+}
+
+TEST_CASE("Layering: the seed programs' code is not in the library", "[core][layering]") {
+  // Runners, experiment metrics and simulators live in examples/apps/.
+  for (const char* gone : {"sim", "apps"}) {
+    INFO(gone);
+    CHECK_FALSE(fs::exists(include_root() / gone));
+  }
+  for (const char* gone :
+       {"fusion/corridor_runner.hpp", "fusion/corridor_metrics.hpp", "filters/trajectory_correction.hpp"}) {
+    INFO(gone);
+    CHECK_FALSE(fs::exists(include_root() / gone));
+  }
+  // And no library header reaches into examples/apps.
+  const std::regex apps_re(R"(^\s*#\s*include\s*[<"]apps/)");
+  for (const auto& entry : fs::recursive_directory_iterator(include_root())) {
+    if (!entry.is_regular_file()) continue;
+    std::ifstream in(entry.path());
+    std::string text;
+    int line_no = 0;
+    while (std::getline(in, text)) {
+      ++line_no;
+      INFO(entry.path().string() << ":" << line_no);
+      CHECK_FALSE(std::regex_search(text, apps_re));
+    }
+  }
+}
