@@ -41,6 +41,36 @@ TEST_CASE("Ekf fuzz regression: predict never reports kApplied with a non-finite
   CHECK((st != FilterStatus::kApplied || ekf.covariance().allFinite()));
 }
 
+TEST_CASE("Ekf fuzz regression: a refused predict leaves last_jacobian() as it was",
+          "[filters][ekf][fuzz]") {
+  // fuzz_ekf crash-02ec104d (Unicycle, exact arc). P0 is PSD with entries
+  // ~1e245 and nearly singular; after a huge step (ds = dtheta = 1.2e5) the
+  // product F P F^T is indefinite by round-off, so predict() returns
+  // kNotPositiveDefinite -- but it has already stored that step's Jacobian
+  // (ekf.hpp: `F_ = F;` before the PSD check), so last_jacobian() changes
+  // although "the filter is unchanged unless kApplied".
+  Unicycle<double> motion;
+  motion.method = Integration::kExactArc;
+  motion.control_cov = Eigen::Vector2d(0.01, 0.00106103515625).asDiagonal();
+  Ekf<Unicycle<double>, HeadingFix<double>> ekf(motion, HeadingFix<double>(0.05));
+  Eigen::Matrix3d P0;
+  P0 << 9.0906767187866891e+245, -6.3444522106644728e+245, 6.3028408015985611e+245,  //
+      -6.3444522106644728e+245, 4.4278413036315374e+245, -4.3988003857324864e+245,   //
+      6.3028408015985611e+245, -4.3988003857324864e+245, 4.3699499387321408e+245;
+  const PlanarPose<double> x0{-1.0066020085824408, -1.4423141889417646, -0.11316631141900402};
+  REQUIRE_NOTHROW(ekf.reset(x0, P0));
+  const Eigen::Matrix3d F0 = ekf.last_jacobian();
+  const FilterStatus st = ekf.predict(Eigen::Vector2d(341.328125, 341.328125), 341.328125);
+  INFO("status " << to_string(st) << "\nP after the step:\n" << ekf.covariance());
+  if (st == FilterStatus::kApplied) {
+    CHECK(is_positive_semidefinite(ekf.covariance()));
+  } else {
+    CHECK(minus(ekf.state(), x0).isZero(0.0));
+    CHECK(ekf.covariance() == P0);
+    CHECK(ekf.last_jacobian() == F0);
+  }
+}
+
 TEST_CASE("Ekf fuzz regression: an update never reports kApplied with a non-finite covariance",
           "[filters][ekf][fuzz]") {
   // Same overflow in covariance_update(): a position fix leaves the

@@ -262,15 +262,17 @@ class Ekf {
     if constexpr (has_identity_jacobian_v<Motion>) {
       P_new = P_ + Covariance(motion_.noise(x_, u, dt));
       if (!minus(x_new, x_).allFinite() || !P_new.allFinite()) return FilterStatus::kNonFinite;
+      P_new = symmetrised(P_new);
+      if (!is_positive_semidefinite(P_new)) return FilterStatus::kNotPositiveDefinite;
       // F_ stays the identity it was initialised to.
     } else {
       const Covariance F = motion_.jacobian(x_, u, dt);
       P_new = F * P_ * F.transpose() + Covariance(motion_.noise(x_, u, dt));
       if (!minus(x_new, x_).allFinite() || !P_new.allFinite()) return FilterStatus::kNonFinite;
-      F_ = F;
+      P_new = symmetrised(P_new);
+      if (!is_positive_semidefinite(P_new)) return FilterStatus::kNotPositiveDefinite;
+      F_ = F;  // recorded for the smoother only when the step is applied
     }
-    P_new = symmetrised(P_new);
-    if (!is_positive_semidefinite(P_new)) return FilterStatus::kNotPositiveDefinite;
     x_ = x_new;
     P_ = P_new;
     return FilterStatus::kApplied;
