@@ -1,0 +1,371 @@
+// Writes the seed corpora of the fuzz harnesses: make_seed_corpus <dir>
+// creates <dir>/<harness>/<seed> files, a few valid inputs (written with the
+// library's own writers) and edge cases per format. It checks what it
+// writes: every seed named valid_* must be accepted by the reader and every
+// seed named bad_* rejected with posefuse::io_error, so a format change
+// that invalidates the seeds fails the build instead of silently starving
+// the fuzzers. Nothing is copied from the real datasets.
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <initializer_list>
+#include <iterator>
+#include <limits>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <posefuse/core/error.hpp>
+#include <posefuse/core/trajectory.hpp>
+#include <posefuse/io/kitti.hpp>
+#include <posefuse/io/robot_log.hpp>
+#include <posefuse/io/tum.hpp>
+
+#include "fuzz_support.hpp"
+
+namespace fs = std::filesystem;
+using posefuse_fuzz::ByteWriter;
+using posefuse_fuzz::join_files;
+
+namespace {
+
+int g_errors = 0;
+
+std::string slurp(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void put(const fs::path& dir, const std::string& name, const std::string& bytes) {
+  fs::create_directories(dir);
+  std::ofstream out(dir / name, std::ios::binary | std::ios::trunc);
+  out << bytes;
+  if (!out) {
+    std::fprintf(stderr, "make_seed_corpus: cannot write %s\n", (dir / name).string().c_str());
+    ++g_errors;
+  }
+}
+
+/// Checks that a seed `<harness>/<seed>` is accepted (valid_*) or rejected
+/// (bad_*) by `read`.
+void expect(const std::string& name, const std::function<void()>& read) {
+  const bool valid = name.find("/valid_") != std::string::npos;
+  std::string why;
+  bool accepted = true;
+  try {
+    read();
+  } catch (const posefuse::io_error& e) {
+    accepted = false;
+    why = e.what();
+  }
+  if (accepted != valid) {
+    std::fprintf(stderr, "make_seed_corpus: seed %s was %s%s%s\n", name.c_str(),
+                 accepted ? "accepted" : "rejected", why.empty() ? "" : ": ", why.c_str());
+    ++g_errors;
+  }
+}
+
+// --- trajectories ------------------------------------------------------------
+
+/// A short drive on KITTI's road plane (x right, y down, z forward): yaw about y.
+posefuse::Trajectory drive(int n) {
+  posefuse::Trajectory t;
+  for (int k = 0; k < n; ++k) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = Eigen::AngleAxisd(0.05 * k, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    T.translation() = Eigen::Vector3d(0.3 * k * k / 10.0, -0.01 * k, 1.2 * k);
+    t.push_back(1317384506.4 + 0.1036 * k, T);
+  }
+  return t;
+}
+
+void kitti_seeds(const fs::path& out, const fs::path& tmp) {
+  const fs::path dir = out / "fuzz_kitti";
+  const fs::path tdir = out / "fuzz_kitti_times";
+  const posefuse::Trajectory t = drive(6);
+  posefuse::write_kitti(tmp / "poses.txt", t);
+  posefuse::write_kitti_times(tmp / "times.txt", t);
+  const std::string poses = slurp(tmp / "poses.txt");
+  const std::string times = slurp(tmp / "times.txt");
+  const std::string identity = "1 0 0 0 0 1 0 0 0 0 1 0\n";
+  const auto seed = [&](const std::string& name, const std::string& p,
+                        const std::string* s = nullptr) {
+    const std::string bytes = s ? join_files({p, *s}) : p;
+    put(dir, name, bytes);
+    expect("fuzz_kitti/" + name, [&] {
+      posefuse_fuzz::write_bytes(tmp / "p.txt", p);
+      if (s) {
+        posefuse_fuzz::write_bytes(tmp / "s.txt", *s);
+        (void)posefuse::read_kitti(tmp / "p.txt", tmp / "s.txt");
+      } else {
+        (void)posefuse::read_kitti(tmp / "p.txt");
+      }
+    });
+  };
+  seed("valid_written", poses);
+  seed("valid_written_with_times", poses, &times);
+  seed("valid_empty", "");
+  seed("valid_comments_crlf_signs",
+       "# KITTI poses\r\n\r\n+1 0 0 +0.5 0 1 0 -2e-1 0 0 1 1E2\r\n   \r\n" + identity);
+  // Rounded to 6 digits as real files are: re-orthonormalised on reading.
+  seed("valid_rounded_rotation",
+       "0.998750 0 0.049979 1.5 0 1 0 0 -0.049979 0 0.998750 3.25\n" + identity);
+  const std::string two = identity + identity;
+  const std::string two_times = "0\n0.1\n";
+  seed("valid_two_with_times", two, &two_times);
+  seed("bad_reflection", "-1 0 0 0 0 1 0 0 0 0 1 0\n");
+  seed("bad_not_orthonormal", "1 0.1 0 0 0 1 0 0 0 0 1 0\n");
+  seed("bad_eleven_numbers", "1 0 0 0 0 1 0 0 0 0 1\n");
+  seed("bad_nan", "1 0 0 nan 0 1 0 0 0 0 1 0\n");
+  seed("bad_out_of_range", "1 0 0 1e999 0 1 0 0 0 0 1 0\n");
+  seed("bad_token", "1 0 0 0x1p3 0 1 0 0 0 0 1 0\n");
+  const std::string three_times = "0\n0.1\n0.2\n";
+  seed("bad_more_times_than_poses", two, &three_times);
+  const std::string one_time = "0\n";
+  seed("bad_fewer_times_than_poses", two, &one_time);
+  const std::string repeated = "0\n0\n";
+  seed("bad_repeated_time", two, &repeated);
+
+  const auto tseed = [&](const std::string& name, const std::string& s) {
+    put(tdir, name, s);
+    expect("fuzz_kitti_times/" + name, [&] {
+      posefuse_fuzz::write_bytes(tmp / "s.txt", s);
+      (void)posefuse::read_kitti_times(tmp / "s.txt");
+    });
+  };
+  tseed("valid_written", times);
+  tseed("valid_scientific_crlf", "# stamps\r\n0.000000e+00\r\n1.036000e-01\r\n+2.07e-1\r\n");
+  tseed("valid_empty", "");
+  tseed("bad_equal", "1\n1\n");
+  tseed("bad_two_numbers", "1 2\n");
+  tseed("bad_inf", "inf\n");
+}
+
+void tum_seeds(const fs::path& out, const fs::path& tmp) {
+  const fs::path dir = out / "fuzz_tum";
+  posefuse::write_tum(tmp / "t.tum", drive(6));
+  const auto seed = [&](const std::string& name, const std::string& s) {
+    put(dir, name, s);
+    expect("fuzz_tum/" + name, [&] {
+      posefuse_fuzz::write_bytes(tmp / "s.tum", s);
+      (void)posefuse::read_tum(tmp / "s.tum");
+    });
+  };
+  seed("valid_written", slurp(tmp / "t.tum"));
+  seed("valid_unnormalised_negative_w", "1.5 1 2 3 0 0 0 -1.0004\r\n1.6 1 2 3 0.70710678 0 0 0.70710678\n");
+  seed("valid_empty", "# nothing\n");
+  seed("bad_zero_quaternion", "0 0 0 0 0 0 0 0\n");
+  seed("bad_far_from_unit", "0 0 0 0 0 0 0 1.1\n");
+  seed("bad_not_increasing", "1 0 0 0 0 0 0 1\n0.5 0 0 0 0 0 0 1\n");
+  seed("bad_seven_numbers", "1 0 0 0 0 0 1\n");
+}
+
+// --- robot log ---------------------------------------------------------------
+
+posefuse::RobotLog small_log(bool with_truth) {
+  posefuse::RobotLog log;
+  log.params = {1024, 0.05, 0.3, 0.98, 0.5};
+  const std::int64_t t0 = 1'700'000'000'000'000'000;
+  for (int i = 0; i < 8; ++i) {
+    posefuse::WheelSample w;
+    w.t_ns = t0 + i * 20'000'000;
+    w.ticks = {30 * i, 32 * i, 30 * i, 32 * i};
+    log.wheels.push_back(w);
+  }
+  for (int i = 0; i < 6; ++i) {
+    posefuse::ImuSample s;
+    s.t_ns = t0 + 1'000'000 + i * 25'000'000;
+    s.accel_mps2 = {0.02 * i, -0.01, 9.81};
+    s.gyro_radps = {0.0, 0.001, 0.05};
+    s.mag_uT = {22.5, -3.0, -40.25};
+    log.imu.push_back(s);
+  }
+  const posefuse::SlamState states[4] = {posefuse::SlamState::kTracking, posefuse::SlamState::kLost,
+                                         posefuse::SlamState::kReinit, posefuse::SlamState::kTracking};
+  for (int i = 0; i < 4; ++i) {
+    posefuse::SlamSample s;
+    s.t_ns = t0 + 2'000'000 + i * 40'000'000;
+    s.state = states[i];
+    s.position_m = {0.01 * i, 0.002 * i, 0.0};
+    s.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(0.01 * i, Eigen::Vector3d::UnitZ()));
+    if (s.state == posefuse::SlamState::kLost) {
+      s.position_m.setConstant(std::numeric_limits<double>::quiet_NaN());
+      s.orientation.coeffs().setConstant(std::numeric_limits<double>::quiet_NaN());
+    }
+    log.slam.push_back(s);
+  }
+  if (with_truth) {
+    for (int i = 0; i < 4; ++i) {
+      posefuse::PlanarPoseSample g;
+      g.t_ns = t0 + i * 45'000'000;
+      g.pose = {0.01 * i, 0.0, 0.001 * i};
+      log.groundtruth.push_back(g);
+    }
+  }
+  return log;
+}
+
+void robot_log_seeds(const fs::path& out, const fs::path& tmp) {
+  const fs::path dir = out / "fuzz_robot_log";
+  const char* names[5] = {"robot.txt", "wheels.csv", "imu.csv", "slam.csv", "groundtruth.csv"};
+  const auto files_of = [&](const posefuse::RobotLog& log) {
+    const fs::path d = tmp / "log";
+    fs::remove_all(d);
+    posefuse::write_robot_log(d, log);
+    std::vector<std::string> files;
+    for (const char* n : names) {
+      if (fs::exists(d / n)) files.push_back(slurp(d / n));
+    }
+    return files;
+  };
+  const auto seed = [&](const std::string& name, const std::vector<std::string>& files) {
+    put(dir, name, join_files(files));
+    expect("fuzz_robot_log/" + name, [&] {
+      const fs::path d = tmp / "check";
+      fs::remove_all(d);
+      fs::create_directories(d);
+      for (std::size_t i = 0; i < files.size(); ++i) posefuse_fuzz::write_bytes(d / names[i], files[i]);
+      (void)posefuse::read_robot_log(d);
+    });
+  };
+  const std::vector<std::string> full = files_of(small_log(true));
+  seed("valid_written", full);
+  seed("valid_written_without_truth", files_of(small_log(false)));
+
+  std::vector<std::string> edited = full;
+  edited[0] = "ticks_per_rev = 1024  # encoder\r\nWHEEL_RADIUS_M\t0.05\ntrack_width_m 0.3\n"
+              "complementary_alpha=0.98\nfuser_threshold 5e-1\n";
+  edited[1] = "t_ns,fl,fr,bl,br\r\n" + full[1];
+  edited[3] = "t_ns,state,x,y,z,qx,qy,qz,qw\n"
+              "1700000000002000000,TRACKING,0,0,0,0,0,0,1\n"
+              "1700000000042000000,lost,,,,,,,\n"
+              "1700000000082000000, Reinit ,+0.02,0.004,0,0,0,0.01,0.99995\n";
+  seed("valid_headers_keys_lost_row", edited);
+
+  std::vector<std::string> bad = full;
+  bad[1] = "# t_ns,fl,fr,bl,br\n1700000000000000000,0,0,0,0\n1700000000020000000,4000000,0,0,0\n";
+  seed("bad_wheel_wraparound", bad);
+  bad = full;
+  bad[2] = "1700000000001000000,0,0,-9.81,0,0,0,0,0,0\n";
+  seed("bad_imu_z_down", bad);
+  bad = full;
+  bad[0] = "ticks_per_rev 1024\nwheel_radius_m 0.05\ntrack_width_m 0.3\ncomplementary_alpha 1\n"
+           "fuser_threshold 0.5\n";
+  seed("bad_alpha_one", bad);
+  seed("bad_missing_slam", {full[0], full[1], full[2]});
+}
+
+// --- EKF operations ----------------------------------------------------------
+// The byte layout decoded by fuzz_ekf.cpp: choices are single bytes, numbers
+// as written by ByteWriter; operations 0 reset, 1 predict, 2 update<I>,
+// 3 update<I> with a gate, 4 update_with, 5 set_gate; covariance modes 0
+// diagonal, 1 L L^T, 2 symmetric, 3 full.
+
+struct Ops {
+  ByteWriter w;
+  Ops& b(std::uint8_t x) {
+    w.byte(x);
+    return *this;
+  }
+  Ops& n(std::initializer_list<double> v) {
+    for (const double x : v) w.raw(x);
+    return *this;
+  }
+  Ops& s(std::uint8_t i) {
+    w.special(i);
+    return *this;
+  }
+  Ops& diag(std::initializer_list<double> v) { return b(0).n(v); }
+};
+
+constexpr std::uint8_t kNaN = 30, kInf = 28, kMax = 17, kDenorm = 20, kNegOne = 3;
+
+void ekf_seeds(const fs::path& out) {
+  const fs::path dir = out / "fuzz_ekf";
+  {  // constant velocity, all three position fixes
+    Ops o;
+    o.b(0).n({0.5}).diag({0.25}).diag({0.25, 0.25}).diag({0.25, 0.25, 1, 1});
+    o.b(1).n({0.1});                                                  // predict before reset
+    o.b(0).n({0, 0, 1, 0}).diag({1, 1, 4, 4});                        // reset
+    o.b(1).n({0.1}).b(2).b(1).n({0.12, 0.01});                        // predict, update<1>
+    o.b(2).b(1).n({0.12, 0.01});                                      // same P: memoised gain
+    o.b(2).b(0).n({0.2}).b(2).b(2).n({0.2, 0.0, 1.0, 0.1});           // update<0>, update<2>
+    o.b(3).b(1).n({5, 5}).b(0).n({9.21});                             // gated by NIS
+    o.b(3).b(1).n({0.3, 0}).b(1).b(1);                                // functor says no
+    o.b(4).b(1).b(2).n({1, 0.5, 2}).n({0.3, 0.02}).b(1);              // update_with, symmetric noise
+    o.b(5).b(1).n({4}).b(5).b(0).s(kNegOne);                          // set_gate, bad gate
+    o.b(1).s(kNaN).b(1).n({-0.1}).b(1).s(kInf);                       // bad dt
+    o.b(0).n({0, 0, 0, 0}).b(2).n({1, 2, 3, 4, 5, 6, 7, 8, 9, 10});   // indefinite reset
+    put(dir, "cv_sequence", o.w.bytes());
+  }
+  {  // constant velocity pushed to the limits of double
+    Ops o;
+    o.b(0).n({1}).diag({1}).diag({1, 1}).diag({1, 1, 1, 1});
+    o.b(0).n({0, 0, 0, 0}).b(0).s(kMax).s(kMax).s(kMax).s(kMax);
+    o.b(1).n({0}).b(2).b(0).n({1});
+    o.b(0).n({1e300, -1e300, 0, 0}).b(0).s(kDenorm).s(kDenorm).n({1, 1});
+    o.b(1).n({1e10}).b(2).b(1).n({1, 1});
+    put(dir, "cv_extremes", o.w.bytes());
+  }
+  {  // unicycle, exact arc
+    Ops o;
+    o.b(1).b(1).diag({0.01, 0.001}).diag({0.04, 0.04, 0.01}).n({0.05});
+    o.b(0).n({0, 0, 3.1}).diag({0.1, 0.1, 0.05});
+    o.b(1).n({1.0, 0.8, 0.1}).b(2).b(0).n({0.1, 0.01, -3.1});         // wraps at +-pi
+    o.b(2).b(1).n({3.13}).b(4).b(1).n({0.02}).n({-3.12}).b(1);
+    o.b(4).b(0).b(1).n({0.1, 0, 0, 0.1, 0, 0.1}).n({0.1, 0, 3}).b(0).n({11.3});
+    o.b(1).n({5, 100, 0.5}).b(3).b(0).n({0, 0, 0}).b(2).b(0);
+    put(dir, "unicycle_sequence", o.w.bytes());
+  }
+  {  // unicycle, Euler
+    Ops o;
+    o.b(1).b(0).diag({0.04, 0.01}).diag({0.01, 0.01, 0.0025}).n({0.02});
+    o.b(0).n({1, 2, -3}).diag({0, 0, 0});                             // exact belief
+    o.b(1).n({0.5, 0.2, 0.05}).b(2).b(0).n({1.02, 2.0, -3.0});
+    put(dir, "unicycle_euler_zero_cov", o.w.bytes());
+  }
+  {  // SE(2) odometry
+    Ops o;
+    o.b(2).n({0.02, 0.005, 0.03}).diag({0.01, 0.01, 0.0025}).n({0.05});
+    o.b(0).n({0, 0, 0}).diag({0.01, 0.01, 0.01});
+    o.b(1).n({0.1, 0.0, 0.02, 0.1}).b(1).n({0.1, 0.01, -0.02, 0.1});
+    o.b(2).b(0).n({0.2, 0.0, 0.0}).b(2).b(1).n({0.01});
+    o.b(1).n({1e8, -1e8, 7, 0}).b(2).b(0).n({1e8, 1e8, 1});
+    put(dir, "se2_sequence", o.w.bytes());
+  }
+  {  // planar displacement (identity Jacobians)
+    Ops o;
+    o.b(3).diag({0.01, 0.01}).diag({0.25, 0.25});
+    o.b(0).n({0, 0}).diag({1, 1});
+    o.b(1).n({0.5, 0.1, 0}).b(2).b(0).n({0.6, 0.05});
+    o.b(4).b(2).n({1, 0.999, 1}).n({0.5, 0.2}).b(1);                  // nearly singular noise
+    o.b(3).b(0).n({1, 1}).b(2).b(1);
+    put(dir, "displacement_sequence", o.w.bytes());
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 2) {
+    std::fprintf(stderr, "usage: make_seed_corpus <output folder>\n");
+    return 2;
+  }
+  const fs::path out = argv[1];
+  const posefuse_fuzz::ScratchDir tmp("seed-corpus");
+  kitti_seeds(out, tmp.path());
+  tum_seeds(out, tmp.path());
+  robot_log_seeds(out, tmp.path());
+  ekf_seeds(out);
+  if (g_errors > 0) {
+    std::fprintf(stderr, "make_seed_corpus: %d error(s)\n", g_errors);
+    return 1;
+  }
+  return 0;
+}
