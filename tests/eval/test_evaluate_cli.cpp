@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 
 #include <posefuse/eval/metrics.hpp>
 #include <posefuse/io/association.hpp>
@@ -104,6 +105,24 @@ TEST_CASE("Evaluate CLI: JSON output equals the library and errors exit cleanly"
     CHECK(count_lines(r.err) == 1);
     CHECK(r.err.find("bad.tum:2: expected 8") != std::string::npos);
     CHECK(r.out.empty());
+    // An empty input names its file (it used to pass as 0 poses), and an
+    // endless one without line ends stops at the line-length cap.
+    std::ofstream(dir.path() / "empty.tum") << "# no poses\n";
+    for (const auto& [gt, message] :
+         {std::pair<std::string, std::string>{(dir.path() / "empty.tum").string(),
+                                              "empty.tum: no poses"},
+          {"/dev/zero", "/dev/zero:1: line longer than 1048576 bytes"}}) {
+      INFO(gt);
+      const Run e = run(exe,
+                        "--format tum --groundtruth '" + gt + "' --estimate '" +
+                            (dir.path() / "ref.tum").string() + "'",
+                        dir);
+      CHECK(e.status == 1);
+      CHECK(count_lines(e.err) == 1);
+      CHECK(e.err.rfind("evaluate_trajectory: ", 0) == 0);
+      CHECK(e.err.find(message) != std::string::npos);
+      CHECK(e.out.empty());
+    }
     const Run far = run(exe, files + " --max-time-diff 0.001", dir);
     CHECK(far.status == 1);
     CHECK(far.err.find("found no matching timestamps") != std::string::npos);

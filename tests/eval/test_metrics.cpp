@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <utility>
 #include <vector>
@@ -140,6 +141,26 @@ TEST_CASE("Metrics: RPE by frames, by hand", "[eval][metrics][rpe]") {
     o.delta = 5;
     CHECK_THROWS_WITH(posefuse::rpe(ref, est, o), Catch::Contains("empty index list"));
   }
+}
+
+TEST_CASE("Metrics: RPE with a delta in frames beyond any size_t says the list is empty",
+          "[eval][metrics][rpe]") {
+  // Regression: the delta was cast to size_t unchecked, undefined behaviour
+  // for 1e300 or 2^64 (x86 turned both into 0: "must be at least 1").
+  const posefuse::Trajectory ref = straight_line(5);
+  posefuse::RpeOptions o;
+  for (const double delta : {1e300, 1.8446744073709552e19, 9.223372036854775808e18, 1e19, 5.0}) {
+    INFO("delta " << delta);
+    o.delta = delta;
+    CHECK_THROWS_WITH(posefuse::rpe(ref, ref, o), Catch::Contains("produced an empty index list") &&
+                                                      Catch::Contains("(frames)"));
+  }
+  o.delta = 1e300;
+  CHECK_THROWS_WITH(posefuse::rpe(ref, ref, o), Catch::StartsWith("rpe: delta = 1e+300 (frames)"));
+  o.delta = 4;  // n - 1: one pair
+  CHECK(posefuse::rpe(ref, ref, o).pairs == Pairs{{0, 4}});
+  // The index pairs themselves do not wrap around for a step near SIZE_MAX.
+  CHECK(posefuse::rpe_pairs_by_index(5, std::numeric_limits<std::size_t>::max()).empty());
 }
 
 TEST_CASE("Metrics: RPE rotation angle per pair", "[eval][metrics][rpe]") {

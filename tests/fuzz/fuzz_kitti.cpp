@@ -16,6 +16,7 @@
 
 #include <posefuse/core/error.hpp>
 #include <posefuse/core/trajectory.hpp>
+#include <posefuse/io/detail/text.hpp>
 #include <posefuse/io/formats.hpp>
 #include <posefuse/io/kitti.hpp>
 
@@ -47,7 +48,9 @@ void check_accepted(const posefuse::Trajectory& traj, bool with_times,
   for (std::size_t k = 0; k < traj.size(); ++k) {
     const Eigen::Matrix3d R = traj.poses[k].linear();
     const double residual = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
-    require(residual <= 1e-12 && R.determinant() > 0,
+    // The reader keeps a rotation orthonormal to kExactlyOrthonormal and
+    // replaces any other by its nearest rotation (residual ~1e-16).
+    require(residual <= posefuse::detail::traj_io::kExactlyOrthonormal && R.determinant() > 0,
             "read_kitti returned pose " + std::to_string(k) + " whose rotation is not one (residual " +
                 std::to_string(residual) + ")");
     require(traj.poses[k].matrix().row(3) == Eigen::RowVector4d(0, 0, 0, 1),

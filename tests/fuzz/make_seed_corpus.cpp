@@ -110,7 +110,7 @@ void kitti_seeds(const fs::path& out, const fs::path& tmp) {
   };
   seed("valid_written", poses);
   seed("valid_written_with_times", poses, &times);
-  seed("valid_empty", "");
+  seed("bad_empty", "");
   seed("valid_comments_crlf_signs",
        "# KITTI poses\r\n\r\n+1 0 0 +0.5 0 1 0 -2e-1 0 0 1 1E2\r\n   \r\n" + identity);
   // Rounded to 6 digits as real files are: re-orthonormalised on reading.
@@ -141,7 +141,7 @@ void kitti_seeds(const fs::path& out, const fs::path& tmp) {
   };
   tseed("valid_written", times);
   tseed("valid_scientific_crlf", "# stamps\r\n0.000000e+00\r\n1.036000e-01\r\n+2.07e-1\r\n");
-  tseed("valid_empty", "");
+  tseed("bad_empty", "");
   tseed("bad_equal", "1\n1\n");
   tseed("bad_two_numbers", "1 2\n");
   tseed("bad_inf", "inf\n");
@@ -159,7 +159,7 @@ void tum_seeds(const fs::path& out, const fs::path& tmp) {
   };
   seed("valid_written", slurp(tmp / "t.tum"));
   seed("valid_unnormalised_negative_w", "1.5 1 2 3 0 0 0 -1.0004\r\n1.6 1 2 3 0.70710678 0 0 0.70710678\n");
-  seed("valid_empty", "# nothing\n");
+  seed("bad_empty", "# nothing\n");
   seed("bad_zero_quaternion", "0 0 0 0 0 0 0 0\n");
   seed("bad_far_from_unit", "0 0 0 0 0 0 0 1.1\n");
   seed("bad_not_increasing", "1 0 0 0 0 0 0 1\n0.5 0 0 0 0 0 0 1\n");

@@ -4,7 +4,10 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <filesystem>
+#include <locale>
 #include <random>
+#include <sstream>
 #include <string>
 
 #include <posefuse/io/formats.hpp>
@@ -44,6 +47,26 @@ void check_error(const io_error& e, const std::filesystem::path& file, std::size
 }
 
 const std::string kIdentityRow = "1 0 0 0 0 1 0 0 0 0 1 0\n";
+
+// A digit-grouping numpunct facet ("1,234,567"), so that the test needs no
+// system locale to be installed.
+struct GroupingNumpunct : std::numpunct<char> {
+  char do_thousands_sep() const override { return ','; }
+  std::string do_grouping() const override { return "\3"; }
+};
+
+// Installs a grouping global locale for its lifetime, then restores the old one.
+class GroupingGlobalLocale {
+ public:
+  GroupingGlobalLocale()
+      : old_(std::locale::global(std::locale(std::locale::classic(), new GroupingNumpunct))) {}
+  ~GroupingGlobalLocale() { std::locale::global(old_); }
+  GroupingGlobalLocale(const GroupingGlobalLocale&) = delete;
+  GroupingGlobalLocale& operator=(const GroupingGlobalLocale&) = delete;
+
+ private:
+  std::locale old_;
+};
 
 posefuse::Trajectory random_trajectory(std::size_t n, unsigned seed) {
   std::mt19937_64 rng(seed);
@@ -143,6 +166,113 @@ TEST_CASE("Formats: missing or unwritable files name the path", "[io][errors]") 
               "cannot open file for writing");
   check_error(expect_io_error([&] { posefuse::write_tum(out, traj); }), out, 0,
               "cannot open file for writing");
+}
+
+TEST_CASE("Formats: a read error is reported, not taken for the end of the file", "[io][errors]") {
+  // Reading /proc/self/mem at offset 0 fails with EIO (badbit): the readers
+  // returned an empty trajectory for it, as for an empty file.
+  const std::filesystem::path mem = "/proc/self/mem";
+  if (!std::filesystem::exists(mem)) {
+    WARN("SKIPPED: no " << mem);
+    return;
+  }
+  check_error(expect_io_error([&] { (void)posefuse::read_kitti(mem); }), mem, 1, "read error");
+  check_error(expect_io_error([&] { (void)posefuse::read_tum(mem); }), mem, 1, "read error");
+  check_error(expect_io_error([&] { (void)posefuse::read_kitti_times(mem); }), mem, 1,
+              "read error");
+}
+
+TEST_CASE("Formats: a line longer than kMaxLineBytes fails fast, naming file:line",
+          "[io][errors]") {
+  static_assert(posefuse::kMaxLineBytes == 1 << 20);
+  TempDir dir("long-line");
+  // A comment of exactly the cap is still read (and skipped); one byte more is an error.
+  const std::string at_cap = "#" + std::string(posefuse::kMaxLineBytes - 1, 'x') + "\n";
+  const auto ok = dir.write("ok.txt", kIdentityRow + at_cap + kIdentityRow);
+  CHECK(posefuse::read_kitti(ok).size() == 2);
+  const std::string too_long = "#" + std::string(posefuse::kMaxLineBytes, 'x') + "\n";
+  const std::string reason = "line longer than 1048576 bytes";
+  const auto kitti = dir.write("k.txt", kIdentityRow + too_long + kIdentityRow);
+  check_error(expect_io_error([&] { (void)posefuse::read_kitti(kitti); }), kitti, 2, reason);
+  const auto tum = dir.write("t.tum", "0 0 0 0 0 0 0 1\r\n" + too_long);
+  check_error(expect_io_error([&] { (void)posefuse::read_tum(tum); }), tum, 2, reason);
+  // Without a line end at all (the last line of a file).
+  const auto times = dir.write("times.txt", "0\n" + std::string(posefuse::kMaxLineBytes + 1, '1'));
+  check_error(expect_io_error([&] { (void)posefuse::read_kitti_times(times); }), times, 2, reason);
+  // An endless file without line ends stops after about a MiB.
+  const std::filesystem::path zero = "/dev/zero";
+  if (std::filesystem::exists(zero)) {
+    check_error(expect_io_error([&] { (void)posefuse::read_kitti(zero); }), zero, 1, reason);
+  }
+}
+
+TEST_CASE("Formats: a file without any data line is an error naming the file", "[io][errors]") {
+  TempDir dir("empty");
+  const auto empty = dir.write("empty.txt", "");
+  const auto comments = dir.write("comments.txt", "# only a comment\n\n   \r\n");
+  for (const auto& file : {empty, comments}) {
+    check_error(expect_io_error([&] { (void)posefuse::read_kitti(file); }), file, 0, "no poses");
+    check_error(expect_io_error([&] { (void)posefuse::read_tum(file); }), file, 0, "no poses");
+    check_error(expect_io_error([&] { (void)posefuse::read_kitti_times(file); }), file, 0,
+                "no timestamps");
+    check_error(
+        expect_io_error([&] { (void)posefuse::read_trajectory(file, posefuse::Format::kTum); }),
+        file, 0, "no poses");
+  }
+  // An empty times.txt is named, not the pose file.
+  const auto poses = dir.write("p.txt", kIdentityRow);
+  check_error(expect_io_error([&] { (void)posefuse::read_kitti(poses, empty); }), empty, 0,
+              "no timestamps");
+}
+
+TEST_CASE("Formats: a path component longer than the system allows is an io_error",
+          "[io][errors]") {
+  // ENAMETOOLONG escaped from std::filesystem::is_directory as
+  // std::filesystem::filesystem_error.
+  TempDir dir("long-name");
+  const auto file = dir.path() / std::string(300, 'a') / "x.txt";
+  const auto last = dir.path() / (std::string(300, 'b') + ".txt");
+  const posefuse::Trajectory traj = random_trajectory(3, 9);
+  for (const auto& p : {file, last}) {
+    check_error(expect_io_error([&] { (void)posefuse::read_kitti(p); }), p, 0, "");
+    check_error(expect_io_error([&] { (void)posefuse::read_tum(p); }), p, 0, "");
+    check_error(expect_io_error([&] { (void)posefuse::read_kitti_times(p); }), p, 0, "");
+    const auto times = dir.write("times.txt", "0\n1\n2\n");
+    const auto poses = dir.write("poses.txt", kIdentityRow + kIdentityRow + kIdentityRow);
+    check_error(expect_io_error([&] { (void)posefuse::read_kitti(poses, p); }), p, 0, "");
+    check_error(expect_io_error([&] { posefuse::write_kitti(p, traj); }), p, 0,
+                "cannot open file for writing");
+    check_error(expect_io_error([&] { posefuse::write_tum(p, traj); }), p, 0,
+                "cannot open file for writing");
+    check_error(expect_io_error([&] { posefuse::write_kitti_times(p, traj); }), p, 0,
+                "cannot open file for writing");
+  }
+  check_error(expect_io_error([&] { (void)posefuse::read_tum(file); }), file, 0,
+              "cannot access: File name too long");
+}
+
+TEST_CASE("Formats: writers do not depend on the global locale", "[io][locale]") {
+  TempDir dir("locale");
+  posefuse::Trajectory traj = random_trajectory(20, 13);
+  traj.poses[1].translation() = Eigen::Vector3d(1234567.0, -7654321.5, 1e22);
+  const GroupingGlobalLocale grouping;
+  std::ostringstream probe;
+  probe << 1234567;
+  REQUIRE(probe.str() == "1,234,567");  // the global locale groups digits
+  posefuse::write_kitti(dir.path() / "p.txt", traj);
+  posefuse::write_kitti_times(dir.path() / "t.txt", traj);
+  posefuse::write_tum(dir.path() / "a.tum", traj);
+  const posefuse::Trajectory kitti =
+      posefuse::read_kitti(dir.path() / "p.txt", dir.path() / "t.txt");
+  const posefuse::Trajectory tum = posefuse::read_tum(dir.path() / "a.tum");
+  REQUIRE(kitti.size() == traj.size());
+  REQUIRE(tum.size() == traj.size());
+  for (std::size_t k = 0; k < traj.size(); ++k) {
+    CHECK(kitti.t_s[k] == traj.t_s[k]);
+    CHECK(kitti.poses[k].matrix() == traj.poses[k].matrix());
+    CHECK(tum.t_s[k] == traj.t_s[k]);
+    CHECK(tum.poses[k].translation() == traj.poses[k].translation());
+  }
 }
 
 TEST_CASE("Formats: KITTI malformed lines report file:line and the reason", "[io][kitti][errors]") {

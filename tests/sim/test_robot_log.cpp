@@ -6,9 +6,12 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <locale>
+#include <sstream>
 #include <string>
 #include <vector>
 #include <unistd.h>
@@ -293,4 +296,113 @@ TEST_CASE("RobotLog: checks of counters and stamps at the ends of the int64 rang
   for (std::int64_t k = 0; k < 100; ++k)
     near_end.push_back({k * 20'000'000, {hi - 1000 + k, hi - 1000 + k, lo + k, lo + k}});
   CHECK_NOTHROW(posefuse::check_wheel_increments(near_end, p, "wheels.csv"));
+}
+
+TEST_CASE("RobotLog: numbers in messages are never truncated", "[sim][io][robot_log]") {
+  // Regression: num_text printed through a 64-byte snprintf buffer, so the
+  // 306 characters of 1e300 with 4 decimals were cut to 63.
+  std::string expected(400, '\0');
+  expected.resize(std::size_t(std::snprintf(expected.data(), expected.size(), "%.4f", 1e300)));
+  REQUIRE(expected.size() == 306);
+  CHECK(posefuse::detail::num_text(1e300, 4) == expected);
+  CHECK(posefuse::detail::num_text(-1e300, 1).size() == 304);  // '-', 301 digits, ".0"
+  CHECK(posefuse::detail::num_text(0.1, 4) == "0.1000");
+  CHECK(posefuse::detail::num_text(-2.5e-7, 2) == "-0.00");
+  // Through a check: a wheel radius of 1e300 m appears in full, and the
+  // reason after it survives.
+  const posefuse::RobotLogParams p{1320, 1e300, 0.4, 0.98, 0.01};
+  const std::vector<posefuse::WheelSample> w{{0, {0, 0, 0, 0}}, {100'000'000, {5, 0, 0, 0}}};
+  CHECK_THROWS_WITH(posefuse::check_wheel_increments(w, p, "wheels.csv"),
+                    Catch::Contains("wheel_radius_m " + expected + " (more than 10 m/s)") &&
+                        Catch::EndsWith("or t_ns not in nanoseconds?"));
+}
+
+namespace {
+
+// A digit-grouping numpunct facet ("1,700,000,000"), so that the test needs
+// no system locale to be installed.
+struct GroupingNumpunct : std::numpunct<char> {
+  char do_thousands_sep() const override { return ','; }
+  std::string do_grouping() const override { return "\3"; }
+};
+
+}  // namespace
+
+TEST_CASE("RobotLog: writing does not depend on the global locale", "[sim][io][robot_log]") {
+  // Regression: the int64 columns went through operator<< with the global
+  // locale, so a grouping locale wrote "1,700,000,000,..." into the CSV.
+  Scratch d;
+  const auto sim = posefuse::simulate_corridor({}, 3);
+  const std::locale old =
+      std::locale::global(std::locale(std::locale::classic(), new GroupingNumpunct));
+  std::ostringstream probe;
+  probe << std::int64_t{1234567};
+  const bool grouping = probe.str() == "1,234,567";
+  try {
+    posefuse::write_robot_log(d.path(), sim.log);
+  } catch (...) {
+    std::locale::global(old);
+    throw;
+  }
+  std::locale::global(old);
+  REQUIRE(grouping);
+  CHECK(posefuse::read_robot_log(d.path()) == sim.log);
+}
+
+TEST_CASE("RobotLog: empty, unreadable, endless and over-long inputs name the file",
+          "[sim][io][robot_log][errors]") {
+  {  // An empty groundtruth.csv was read as "no ground truth" in silence.
+    Scratch d;
+    minimal_log(d, "groundtruth.csv", "# t_ns,x,y,yaw\n");
+    CHECK(error_of(d) == (d.path() / "groundtruth.csv").string() +
+                             ": has no data rows (remove the file when there is no ground truth)");
+  }
+  {  // A line over the cap is not read to its end.
+    Scratch d;
+    minimal_log(d, "wheels.csv",
+                std::string(kWheels) + "#" + std::string(posefuse::kMaxLineBytes, ' ') + "\n");
+    CHECK(error_of(d) == (d.path() / "wheels.csv").string() + ":5: line longer than " +
+                             std::to_string(posefuse::kMaxLineBytes) + " bytes");
+  }
+  if (fs::exists("/proc/self/mem")) {  // reading it fails with EIO
+    Scratch d;
+    minimal_log(d);
+    fs::remove(d.path() / "imu.csv");
+    fs::create_symlink("/proc/self/mem", d.path() / "imu.csv");
+    CHECK(error_of(d) == (d.path() / "imu.csv").string() + ":1: read error");
+  }
+  if (fs::exists("/dev/zero")) {
+    Scratch d;
+    minimal_log(d);
+    fs::remove(d.path() / "slam.csv");
+    fs::create_symlink("/dev/zero", d.path() / "slam.csv");
+    CHECK(error_of(d) == (d.path() / "slam.csv").string() + ":1: line longer than " +
+                             std::to_string(posefuse::kMaxLineBytes) + " bytes");
+    fs::remove(d.path() / "slam.csv");
+    fs::create_directory(d.path() / "slam.csv");
+    CHECK(error_of(d) ==
+          (d.path() / "slam.csv").string() + ": cannot open file for reading: it is a folder");
+  }
+}
+
+TEST_CASE("RobotLog: a path component longer than the system allows is an io_error",
+          "[sim][io][robot_log][errors]") {
+  // Regression: ENAMETOOLONG escaped from std::filesystem::is_directory as
+  // std::filesystem::filesystem_error.
+  Scratch d;
+  const fs::path dir = d.path() / std::string(300, 'a') / "log";
+  const auto named = [&](const auto& f) {
+    try {
+      f();
+    } catch (const posefuse::io_error& e) {
+      return e.file() == dir && std::string(e.what()).rfind(dir.string() + ": ", 0) == 0;
+    }
+    return false;
+  };
+  CHECK(named([&] { (void)posefuse::read_robot_log(dir); }));
+  CHECK(named([&] { posefuse::write_robot_log(dir, posefuse::simulate_corridor({}, 1).log); }));
+  // A too-long name inside an existing folder.
+  const fs::path file = d.path() / (std::string(300, 'b') + ".txt");
+  CHECK_THROWS_WITH(posefuse::read_robot_params(file),
+                    Catch::StartsWith(file.string() + ": cannot access:"));
 }

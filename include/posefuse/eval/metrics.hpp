@@ -7,11 +7,11 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <charconv>
 #include <cmath>
 #include <cstddef>
 #include <numbers>
 #include <span>
-#include <sstream>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -167,7 +167,7 @@ enum class DeltaUnit {
     std::size_t n, std::size_t delta) {
   if (delta == 0) throw invalid_argument("rpe: delta in frames must be at least 1");
   std::vector<std::pair<std::size_t, std::size_t>> pairs;
-  for (std::size_t i = 0; i + delta < n; i += delta) pairs.emplace_back(i, i + delta);
+  for (std::size_t i = 0; i < n && delta < n - i; i += delta) pairs.emplace_back(i, i + delta);
   return pairs;
 }
 
@@ -229,7 +229,8 @@ struct RpeOptions {
 /// @return per-pair errors, statistics, the similarity and the pairs
 /// @throws posefuse::invalid_argument for different or zero sizes, a bad
 ///         delta (non-integer frames, non-positive), a degenerate alignment,
-///         or when no pair exists for the delta (as evo)
+///         or when no pair exists for the delta (as evo; also for any delta
+///         in frames of at least the number of poses, however large)
 [[nodiscard]] inline MetricResult rpe(const Trajectory& ref, const Trajectory& est,
                                       const RpeOptions& options = {}) {
   if (ref.size() != est.size() || ref.empty()) {
@@ -247,14 +248,18 @@ struct RpeOptions {
         !std::isfinite(options.delta)) {
       throw invalid_argument("rpe: delta in frames must be an integer >= 1");
     }
-    r.pairs = rpe_pairs_by_index(P.size(), static_cast<std::size_t>(options.delta));
+    // A step of n poses or more has no pair; checked in double, because a
+    // huge delta (1e300, 2^64) does not fit in a size_t (the cast would be UB).
+    if (options.delta < static_cast<double>(P.size())) {
+      r.pairs = rpe_pairs_by_index(P.size(), static_cast<std::size_t>(options.delta));
+    }
   } else {
     r.pairs = rpe_pairs_by_path(options.pairs_from_reference ? Q : P, options.delta);
   }
   if (r.pairs.empty()) {
-    std::ostringstream delta;
-    delta << options.delta;
-    throw invalid_argument("rpe: delta = " + delta.str() +
+    char delta[32];  // shortest round-trip text, locale-free; 24 chars suffice for a double
+    const auto printed = std::to_chars(delta, delta + sizeof(delta), options.delta);
+    throw invalid_argument("rpe: delta = " + std::string(delta, printed.ptr) +
                            (options.delta_unit == DeltaUnit::kFrames ? " (frames)" : " (m)") +
                            " produced an empty index list - try lower values");
   }

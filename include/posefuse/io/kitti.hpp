@@ -6,7 +6,9 @@
 /// \f$ T_{world,cam} \f$: `r11 r12 r13 tx r21 r22 r23 ty r31 r32 r33 tz`
 /// (Geiger et al., CVPR 2012, odometry devkit). `times.txt` holds one stamp
 /// (s) a line. Blank lines and lines starting with '#' are skipped; line
-/// numbers in errors are the file's physical, 1-based lines.
+/// numbers in errors are the file's physical, 1-based lines. A file without
+/// any data line is an error, so that an empty input is reported with its
+/// name rather than as an empty trajectory.
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -50,6 +52,7 @@ inline NumberedRows<Eigen::Isometry3d> read_kitti_rows(const std::filesystem::pa
     rows.values.push_back(T);
     rows.lines.push_back(reader.line_no());
   }
+  if (rows.values.empty()) throw io_error(file, "no poses (the file has no data lines)");
   return rows;
 }
 
@@ -69,6 +72,7 @@ inline NumberedRows<double> read_stamp_rows(const std::filesystem::path& file) {
     rows.values.push_back(t);
     rows.lines.push_back(reader.line_no());
   }
+  if (rows.values.empty()) throw io_error(file, "no timestamps (the file has no data lines)");
   return rows;
 }
 
@@ -79,7 +83,10 @@ inline NumberedRows<double> read_stamp_rows(const std::filesystem::path& file) {
 /// @return the stamps in file order
 /// @throws posefuse::io_error (file:line) when the file cannot be opened, a
 ///         line has not exactly one number, a number is unparsable or not
-///         finite, or a stamp is not greater than the previous one
+///         finite, a stamp is not greater than the previous one, a read
+///         fails or a line is longer than kMaxLineBytes; and (file only)
+///         when the path cannot be accessed or the file has no stamp ("no
+///         timestamps")
 [[nodiscard]] inline std::vector<double> read_kitti_times(const std::filesystem::path& file) {
   return detail::traj_io::read_stamp_rows(file).values;
 }
@@ -99,7 +106,10 @@ inline NumberedRows<double> read_stamp_rows(const std::filesystem::path& file) {
 ///         number is unparsable or not finite, a rotation is not
 ///         orthonormal within tolerance or is a reflection, a stamp does not
 ///         increase, or the times file has a different number of entries
-///         (the error names the first line without a partner)
+///         (the error names the first line without a partner), a read fails
+///         or a line is longer than kMaxLineBytes; and (file only) when a
+///         path cannot be accessed or a file has no pose ("no poses") or no
+///         stamp ("no timestamps")
 [[nodiscard]] inline Trajectory read_kitti(
     const std::filesystem::path& poses_file,
     const std::optional<std::filesystem::path>& times_file = std::nullopt,

@@ -29,6 +29,9 @@
 ///   the first data row. `\r\n` line ends and spaces around fields are fine.
 /// * `t_ns` must increase strictly within each file; the files need not share
 ///   timestamps.
+/// * A present `groundtruth.csv` must have data rows (remove it otherwise);
+///   `wheels.csv` needs two rows and `imu.csv` one. Lines are at most
+///   kMaxLineBytes long.
 ///
 /// Every malformed input throws posefuse::io_error whose what() is
 /// `"<file>:<line>: <reason>"` (wrong column count, bad number, NaN/Inf,
@@ -120,11 +123,14 @@ namespace posefuse {
 ///            and optionally groundtruth.csv
 /// @return the log, rows in file order
 /// @throws posefuse::io_error naming file and line for anything malformed;
-///         also when wheels.csv has fewer than two rows or imu.csv none, and
+///         also when wheels.csv has fewer than two rows, imu.csv or a present
+///         groundtruth.csv none, a path cannot be accessed (e.g. a name too
+///         long), a read fails or a line is longer than kMaxLineBytes, and
 ///         for the errors of check_robot_log()
 [[nodiscard]] inline RobotLog read_robot_log(const std::filesystem::path& dir) {
   using detail::CsvLine;
-  if (!std::filesystem::is_directory(dir)) throw io_error(dir, "log folder does not exist");
+  if (!std::filesystem::is_directory(detail::checked_status(dir)))
+    throw io_error(dir, "log folder does not exist");
   RobotLog log;
   log.params = read_robot_params(dir / "robot.txt");
   const auto wheels_file = dir / "wheels.csv";
@@ -173,7 +179,7 @@ namespace posefuse {
     return r;
   });
   const auto gt_file = dir / "groundtruth.csv";
-  if (std::filesystem::exists(gt_file)) {
+  if (detail::checked_status(gt_file).type() != std::filesystem::file_type::not_found) {
     log.groundtruth =
         detail::read_csv<PlanarPoseSample>(gt_file, detail::kTruthCols, [](CsvLine& c) {
           PlanarPoseSample r;
@@ -181,6 +187,9 @@ namespace posefuse {
           for (Eigen::Index i = 0; i < 3; ++i) r.pose(i) = c.real();  // x, y, yaw
           return r;
         });
+    // An empty file would otherwise be read as "no ground truth" in silence.
+    if (log.groundtruth.empty())
+      throw io_error(gt_file, "has no data rows (remove the file when there is no ground truth)");
   }
   (void)check_robot_log(log, dir);  // clocks, IMU axes, SLAM tilt; warnings: run_corridor
   return log;
@@ -188,7 +197,9 @@ namespace posefuse {
 
 /// Writes a log folder in exactly the format read_robot_log reads (creating
 /// the folder). Numbers are written in the shortest form that reads back to
-/// the same double, so a written log reads back bit-identical.
+/// the same double, so a written log reads back bit-identical. Every file is
+/// written with the classic "C" locale, whatever the global locale (a digit
+/// grouping such as `1,700,000,000` would not read back).
 /// @param[in] dir destination folder (created if absent; files overwritten)
 /// @param[in] log the log; groundtruth.csv is written only when non-empty
 /// @throws posefuse::io_error when a file cannot be written

@@ -27,14 +27,15 @@
 /// in the int64 range give messages, not undefined behaviour.
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <cstdio>
 #include <filesystem>
 #include <numbers>
 #include <span>
 #include <string>
+#include <system_error>
 #include <utility>
 #include <vector>
 
@@ -62,10 +63,15 @@ inline std::filesystem::path log_file(const std::filesystem::path& dir, const ch
   return dir.empty() ? std::filesystem::path(name) : dir / name;
 }
 
+/// `v` in fixed notation with `prec` decimals, never truncated (1e300 takes
+/// 301 digits) and locale-free ("C" formatting of std::to_chars).
 inline std::string num_text(double v, int prec) {
-  std::string s(64, '\0');
-  const int n = std::snprintf(s.data(), s.size(), "%.*f", prec, v);
-  s.resize(std::size_t(std::max(0, n)));
+  if (!std::isfinite(v)) return std::isnan(v) ? "nan" : v > 0 ? "inf" : "-inf";
+  // Digits before the point: at most 309 for a double; after it: prec.
+  std::string s(std::size_t(330 + std::max(0, prec)), '\0');
+  const auto [ptr, ec] =
+      std::to_chars(s.data(), s.data() + s.size(), v, std::chars_format::fixed, std::max(0, prec));
+  s.resize(ec == std::errc{} ? std::size_t(ptr - s.data()) : 0);
   return s;
 }
 

@@ -6,7 +6,8 @@
 /// (s), position of the body in the world (m) and the Hamilton unit
 /// quaternion of \f$ R_{world,body} \f$ with the scalar **last**. Fields are
 /// separated by whitespace; blank lines and lines starting with '#' are
-/// skipped; stamps must increase strictly.
+/// skipped; stamps must increase strictly. A file without any pose is an
+/// error (named by its path), not an empty trajectory.
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -32,10 +33,13 @@ namespace posefuse {
 /// @throws posefuse::io_error (file:line) when the file cannot be opened, a
 ///         line has not 8 numbers (the message gives the count found), a
 ///         number is unparsable or not finite, a quaternion is zero or too
-///         far from unit norm, or a stamp is not greater than the previous
+///         far from unit norm, a stamp is not greater than the previous, a
+///         read fails or a line is longer than kMaxLineBytes; and (file
+///         only) when the path cannot be accessed or the file has no pose
+///         ("no poses")
 [[nodiscard]] inline Trajectory read_tum(const std::filesystem::path& file,
                                          const ReadOptions& options = {}) {
-  detail::traj_io::LineReader reader(file);
+  detail::LineReader reader(file);
   Trajectory traj;
   std::size_t previous_line = 0;
   std::string line;
@@ -60,6 +64,7 @@ namespace posefuse {
     traj.push_back(v[0], T);
     previous_line = n;
   }
+  if (traj.empty()) throw io_error(file, "no poses (the file has no data lines)");
   return traj;
 }
 

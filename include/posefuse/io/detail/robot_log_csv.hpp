@@ -19,6 +19,7 @@
 #include <vector>
 
 #include <posefuse/core/error.hpp>
+#include <posefuse/io/detail/line_reader.hpp>
 
 namespace posefuse {
 
@@ -38,21 +39,20 @@ inline std::string lower(std::string_view s) {
 
 /// Reads a text file as (line number, trimmed content) pairs, skipping blank
 /// and `#` lines.
+/// @throws posefuse::io_error for a missing or inaccessible file, a read
+///         error, or a line longer than kMaxLineBytes
 inline std::vector<std::pair<std::size_t, std::string>> read_content_lines(
     const std::filesystem::path& file) {
-  if (!std::filesystem::is_regular_file(file)) throw io_error(file, "required file is missing");
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw io_error(file, "cannot open file");
+  if (checked_status(file).type() == std::filesystem::file_type::not_found)
+    throw io_error(file, "required file is missing");
+  LineReader in(file);
   std::vector<std::pair<std::size_t, std::string>> lines;
   std::string line;
-  std::size_t n = 0;
-  while (std::getline(in, line)) {
-    ++n;
+  while (in.next(line)) {
     const std::string_view t = trim(line);
     if (t.empty() || t.front() == '#') continue;
-    lines.emplace_back(n, std::string(t));
+    lines.emplace_back(in.line_no(), std::string(t));
   }
-  if (in.bad()) throw io_error(file, n, "read error");
   return lines;
 }
 
@@ -159,10 +159,9 @@ inline std::string fmt(double v) {
   return std::string(buf.data(), r.ptr);
 }
 
+/// Opens `file` for writing, locale-free (see open_output_file).
 inline std::ofstream open_for_writing(const std::filesystem::path& file) {
-  std::ofstream out(file, std::ios::binary | std::ios::trunc);
-  if (!out) throw io_error(file, "cannot open file for writing");
-  return out;
+  return open_output_file(file);
 }
 
 inline constexpr std::array<std::string_view, 5> kWheelCols{"t_ns", "fl", "fr", "bl", "br"};

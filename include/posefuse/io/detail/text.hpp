@@ -3,7 +3,8 @@
 /// Line-oriented text parsing shared by the trajectory readers and writers
 /// (not API): tokenising, strict number parsing and round-trip formatting,
 /// and the rotation / quaternion checks, all reporting posefuse::io_error
-/// with the file and 1-based line.
+/// with the file and 1-based line. Lines are read by detail::LineReader
+/// (line_reader.hpp: length cap, read errors).
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -19,44 +20,16 @@
 #include <vector>
 
 #include <posefuse/core/error.hpp>
+#include <posefuse/io/detail/line_reader.hpp>
 
 /// Internals of the trajectory readers/writers; nested so that other io
 /// headers (e.g. robot_log.hpp) can keep their own detail helpers.
 namespace posefuse::detail::traj_io {
 
-/// Reads a text file line by line, counting 1-based line numbers and
-/// stripping a trailing '\r' (files written on Windows).
-class LineReader {
- public:
-  /// @throws posefuse::io_error when the file cannot be opened
-  explicit LineReader(const std::filesystem::path& file) : file_(file), in_(file) {
-    if (std::filesystem::is_directory(file) || !in_) {
-      throw io_error(file, "cannot open file for reading");
-    }
-  }
-  /// Reads the next line into `line`; false at the end of the file.
-  bool next(std::string& line) {
-    if (!std::getline(in_, line)) return false;
-    ++line_no_;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    return true;
-  }
-  /// 1-based number of the line last read.
-  [[nodiscard]] std::size_t line_no() const noexcept { return line_no_; }
-  [[nodiscard]] const std::filesystem::path& file() const noexcept { return file_; }
-
- private:
-  std::filesystem::path file_;
-  std::ifstream in_;
-  std::size_t line_no_ = 0;
-};
-
-/// Opens `file` for writing (truncating it).
+/// Opens `file` for writing (truncating it), locale-free (see open_output_file).
 /// @throws posefuse::io_error when it cannot be opened
 [[nodiscard]] inline std::ofstream open_output(const std::filesystem::path& file) {
-  std::ofstream out(file, std::ios::out | std::ios::trunc);
-  if (!out) throw io_error(file, "cannot open file for writing");
-  return out;
+  return open_output_file(file);
 }
 
 /// Flushes `out` and reports a failed write.
