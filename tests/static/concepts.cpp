@@ -10,6 +10,14 @@
 #include <posefuse/models/planar_pose_fix.hpp>
 #include <posefuse/models/position.hpp>
 #include <posefuse/models/se2_odometry.hpp>
+#include <posefuse/fusion/gated_fuser.hpp>
+#include <posefuse/fusion/threshold_fuser.hpp>
+#include <posefuse/lie/se2.hpp>
+#include <posefuse/lie/se3.hpp>
+#include <posefuse/lie/so2.hpp>
+#include <posefuse/lie/so3.hpp>
+#include <posefuse/models/unicycle.hpp>
+#include <posefuse/sensors/pipelines.hpp>
 
 namespace {
 using namespace posefuse;
@@ -114,4 +122,53 @@ static_assert(!InnovationGate<bool, PlanarPoseFix<double>>);  // not a threshold
 using Seed000 = Ekf<PlanarDisplacement<double>, PositionFix<2>>;
 static_assert(Seed000::Dim == 2);
 static_assert(std::is_same_v<Seed000::Covariance, Eigen::Matrix2d>);
+
+// Every model, Lie type, fuser and pipeline of the library satisfies its
+// concept (checked here rather than in the headers, so that including a
+// header does not instantiate the float variants: compile cost, README).
+// posefuse/fusion/gated_fuser.hpp
+static_assert(Stage<GatedFuser<double>>);
+static_assert(Stage<GatedFuser<float>>);
+// posefuse/fusion/threshold_fuser.hpp
+static_assert(Stage<ThresholdFuser<double>>);
+static_assert(Stage<ThresholdFuser<float>>);
+// posefuse/lie/se2.hpp
+static_assert(Manifold<SE2<double>>);
+static_assert(Manifold<SE2<float>>);
+// posefuse/lie/se3.hpp
+static_assert(Manifold<SE3<double>>);
+static_assert(Manifold<SE3<float>>);
+// posefuse/lie/so2.hpp
+static_assert(Manifold<SO2<double>>);
+static_assert(Manifold<SO2<float>>);
+// posefuse/lie/so3.hpp
+static_assert(Manifold<SO3<double>>);
+static_assert(Manifold<SO3<float>>);
+// posefuse/models/constant_velocity.hpp
+static_assert(MotionModel<ConstantVelocity2<double>>);
+static_assert(MotionModel<ConstantVelocity2<float>>);
+// posefuse/models/heading_fix.hpp
+static_assert(MeasurementModel<HeadingFix<double>>);
+static_assert(MeasurementModel<HeadingFix<float>>);
+// posefuse/models/planar_displacement.hpp
+static_assert(MotionModel<PlanarDisplacement<double>>);
+static_assert(MotionModel<PlanarDisplacement<float>>);
+// posefuse/models/planar_pose.hpp
+static_assert(State<PlanarPose<double>>);
+static_assert(State<PlanarPose<float>>);
+// posefuse/models/planar_pose_fix.hpp
+static_assert(MeasurementModel<PlanarPoseFix<double>>);
+static_assert(MeasurementModel<PlanarPoseFix<float>>);
+// posefuse/models/position.hpp
+static_assert(MeasurementModel<PositionFix<2>>);
+static_assert(MeasurementModel<PositionFix<4, 2, float>>);
+// posefuse/models/se2_odometry.hpp
+static_assert(MotionModel<Se2Odometry<double>>);
+static_assert(MotionModel<Se2Odometry<float>>);
+// posefuse/models/unicycle.hpp
+static_assert(check_motion_model<Unicycle<double>>());
+static_assert(MotionModel<Unicycle<float>>);
+// posefuse/sensors/pipelines.hpp
+static_assert(Stage<AttitudePipeline>);
+static_assert(Stage<OdometryPipeline>);
 }  // namespace

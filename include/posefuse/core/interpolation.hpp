@@ -104,13 +104,15 @@ namespace detail {
 
 /// Index k with t_s[k-1] < t <= t_s[k] (or 0 when t equals the first stamp),
 /// for stamps in time order and t within [front, back].
-inline std::size_t bracket(const std::vector<double>& t_s, double t) {
+template <class Lazy = void>
+std::size_t bracket(const std::vector<double>& t_s, double t) {
   return std::size_t(std::lower_bound(t_s.begin(), t_s.end(), t) - t_s.begin());
 }
 
 /// interpolate_at() on a planar trajectory already checked with
 /// validate_time_order() (no checks; used by loops over many times).
-inline std::optional<Eigen::Vector3d> interpolate_in_order(const PlanarTrajectory& traj, double t_s) {
+template <class Lazy = void>
+std::optional<Eigen::Vector3d> interpolate_in_order(const PlanarTrajectory& traj, double t_s) {
   if (traj.empty() || !(t_s >= traj.t_s.front() && t_s <= traj.t_s.back())) return std::nullopt;
   const std::size_t k = bracket(traj.t_s, t_s);
   if (k == 0) return traj.poses[0];
@@ -120,7 +122,8 @@ inline std::optional<Eigen::Vector3d> interpolate_in_order(const PlanarTrajector
 
 /// Throws unless a Trajectory has matching counts, finite entries and
 /// non-decreasing stamps.
-inline void require_time_order(const Trajectory& traj, const char* what) {
+template <class Lazy = void>
+void require_time_order(const Trajectory& traj, const char* what) {
   if (traj.t_s.size() != traj.poses.size())
     throw invalid_argument(std::string(what) + ": trajectory has mismatched stamp and pose counts");
   for (std::size_t k = 0; k < traj.size(); ++k) {
@@ -147,7 +150,8 @@ inline void require_time_order(const Trajectory& traj, const char* what) {
 /// @throws posefuse::invalid_argument if `t_s` is not finite, or `traj` has
 ///         mismatched counts, a non-finite entry or decreasing stamps
 ///         (PlanarTrajectory::validate_time_order)
-[[nodiscard]] inline std::optional<Eigen::Vector3d> interpolate_at(const PlanarTrajectory& traj,
+template <class Lazy = void>
+[[nodiscard]] std::optional<Eigen::Vector3d> interpolate_at(const PlanarTrajectory& traj,
                                                                  double t_s) {
   if (!std::isfinite(t_s)) throw invalid_argument("interpolate_at: the time is not finite");
   traj.validate_time_order();
@@ -164,7 +168,8 @@ inline void require_time_order(const Trajectory& traj, const char* what) {
 ///         lies outside [t_s.front(), t_s.back()]
 /// @throws posefuse::invalid_argument if `t_s` is not finite, or `traj` has
 ///         mismatched counts, a non-finite entry or decreasing stamps
-[[nodiscard]] inline std::optional<Eigen::Isometry3d> interpolate_at(const Trajectory& traj,
+template <class Lazy = void>
+[[nodiscard]] std::optional<Eigen::Isometry3d> interpolate_at(const Trajectory& traj,
                                                                    double t_s) {
   if (!std::isfinite(t_s)) throw invalid_argument("interpolate_at: the time is not finite");
   detail::require_time_order(traj, "interpolate_at");

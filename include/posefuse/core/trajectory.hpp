@@ -85,7 +85,8 @@ struct Trajectory {
 /// @return `{traj.t_s[ids[i]], traj.poses[ids[i]]}` for every i
 /// @throws posefuse::invalid_argument when an index is out of range or the
 ///         trajectory's stamp and pose counts differ
-[[nodiscard]] inline Trajectory select(const Trajectory& traj, std::span<const std::size_t> ids) {
+template <class Lazy = void>
+[[nodiscard]] Trajectory select(const Trajectory& traj, std::span<const std::size_t> ids) {
   if (traj.t_s.size() != traj.poses.size()) {
     throw invalid_argument("select: trajectory has mismatched stamp and pose counts");
   }
@@ -104,7 +105,8 @@ struct Trajectory {
 
 /// Length of the polyline through the positions,
 /// \f$ \sum_k \lVert p_{k+1} - p_k \rVert \f$ (m), as evo's `path_length()`.
-[[nodiscard]] inline double path_length(const Trajectory& traj) noexcept {
+template <class Lazy = void>
+[[nodiscard]] double path_length(const Trajectory& traj) noexcept {
   double length = 0.0;
   for (std::size_t k = 1; k < traj.poses.size(); ++k) {
     length += (traj.poses[k].translation() - traj.poses[k - 1].translation()).norm();
@@ -116,7 +118,8 @@ struct Trajectory {
 /// @param[in] traj the trajectory
 /// @param[in] plane the plane to keep (`Plane::kXZ` for KITTI's road plane)
 /// @return one 2-D point per pose (m)
-[[nodiscard]] inline std::vector<Eigen::Vector2d> project_to_plane(const Trajectory& traj,
+template <class Lazy = void>
+[[nodiscard]] std::vector<Eigen::Vector2d> project_to_plane(const Trajectory& traj,
                                                                    Plane plane) {
   std::vector<Eigen::Vector2d> out;
   out.reserve(traj.poses.size());

@@ -29,7 +29,8 @@ enum class Alignment {
 
 /// Parses "none", "se3" or "sim3".
 /// @throws posefuse::invalid_argument for any other text
-[[nodiscard]] inline Alignment parse_alignment(std::string_view name) {
+template <class Lazy = void>
+[[nodiscard]] Alignment parse_alignment(std::string_view name) {
   if (name == "none") return Alignment::kNone;
   if (name == "se3") return Alignment::kSE3;
   if (name == "sim3") return Alignment::kSim3;
@@ -138,7 +139,8 @@ template <class Lazy = void>
 /// @param[in] traj the trajectory to move
 /// @param[in] a the similarity
 /// @return the moved trajectory (stamps unchanged)
-[[nodiscard]] inline Trajectory apply_alignment(const Trajectory& traj, const AlignmentResult& a) {
+template <class Lazy = void>
+[[nodiscard]] Trajectory apply_alignment(const Trajectory& traj, const AlignmentResult& a) {
   Eigen::Isometry3d T_align = Eigen::Isometry3d::Identity();
   T_align.linear() = a.rotation;
   T_align.translation() = a.translation;
@@ -164,7 +166,8 @@ struct AlignedTrajectory {
 /// @return the aligned estimate and the similarity
 /// @throws posefuse::invalid_argument for different sizes or the
 ///         degenerate cases of `umeyama_alignment`
-[[nodiscard]] inline AlignedTrajectory align_trajectory(const Trajectory& est,
+template <class Lazy = void>
+[[nodiscard]] AlignedTrajectory align_trajectory(const Trajectory& est,
                                                         const Trajectory& ref,
                                                         Alignment alignment) {
   if (est.size() != ref.size()) {

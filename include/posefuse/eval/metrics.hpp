@@ -31,7 +31,8 @@ namespace posefuse {
 /// @param[in] est_xy estimated road-plane positions (m), same count
 /// @return the RMSE (m)
 /// @throws posefuse::invalid_argument for different or zero lengths
-[[nodiscard]] inline double rmse_2d(std::span<const Eigen::Vector2d> gt_xy,
+template <class Lazy = void>
+[[nodiscard]] double rmse_2d(std::span<const Eigen::Vector2d> gt_xy,
                                     std::span<const Eigen::Vector2d> est_xy) {
   if (gt_xy.size() != est_xy.size()) {
     throw invalid_argument("rmse_2d: " + std::to_string(gt_xy.size()) + " ground-truth but " +
@@ -53,7 +54,8 @@ enum class PoseRelation {
 
 /// Parses "trans" (or "trans_part"), "angle_deg", "angle_rad" or "full".
 /// @throws posefuse::invalid_argument for any other text
-[[nodiscard]] inline PoseRelation parse_pose_relation(std::string_view name) {
+template <class Lazy = void>
+[[nodiscard]] PoseRelation parse_pose_relation(std::string_view name) {
   if (name == "trans" || name == "trans_part") return PoseRelation::kTranslation;
   if (name == "angle_deg") return PoseRelation::kRotationAngleDeg;
   if (name == "angle_rad") return PoseRelation::kRotationAngleRad;
@@ -79,13 +81,15 @@ enum class PoseRelation {
 /// `Rotation.from_matrix(R).as_rotvec()`).
 /// @param[in] R a rotation matrix
 /// @return the angle (rad)
-[[nodiscard]] inline double rotation_angle(const Eigen::Matrix3d& R) noexcept {
+template <class Lazy = void>
+[[nodiscard]] double rotation_angle(const Eigen::Matrix3d& R) noexcept {
   const Eigen::Vector3d v(R(2, 1) - R(1, 2), R(0, 2) - R(2, 0), R(1, 0) - R(0, 1));
   return std::atan2(0.5 * v.norm(), 0.5 * (R.trace() - 1.0));
 }
 
 /// The error of an error pose \f$ E \f$ under a pose relation (see PoseRelation).
-[[nodiscard]] inline double pose_error(const Eigen::Isometry3d& E, PoseRelation relation) noexcept {
+template <class Lazy = void>
+[[nodiscard]] double pose_error(const Eigen::Isometry3d& E, PoseRelation relation) noexcept {
   switch (relation) {
     case PoseRelation::kTranslation: return E.translation().norm();
     case PoseRelation::kRotationAngleDeg:
@@ -120,7 +124,8 @@ struct MetricResult {
 /// @return errors, statistics and the similarity used
 /// @throws posefuse::invalid_argument for different or zero sizes, or a
 ///         degenerate alignment
-[[nodiscard]] inline MetricResult ape(const Trajectory& ref, const Trajectory& est,
+template <class Lazy = void>
+[[nodiscard]] MetricResult ape(const Trajectory& ref, const Trajectory& est,
                                       PoseRelation relation = PoseRelation::kTranslation,
                                       Alignment alignment = Alignment::kNone) {
   if (ref.size() != est.size() || ref.empty()) {
@@ -151,7 +156,8 @@ enum class DeltaUnit {
 
 /// Parses "frames" (or "f") and "m" (or "meters").
 /// @throws posefuse::invalid_argument for any other text
-[[nodiscard]] inline DeltaUnit parse_delta_unit(std::string_view name) {
+template <class Lazy = void>
+[[nodiscard]] DeltaUnit parse_delta_unit(std::string_view name) {
   if (name == "frames" || name == "f") return DeltaUnit::kFrames;
   if (name == "m" || name == "meters") return DeltaUnit::kMeters;
   throw invalid_argument("unknown delta unit '" + std::string(name) + "' (expected frames or m)");
@@ -163,7 +169,8 @@ enum class DeltaUnit {
 /// @param[in] delta index step (>= 1)
 /// @return pairs \f$ (k\delta, (k+1)\delta) \f$
 /// @throws posefuse::invalid_argument when `delta` is 0
-[[nodiscard]] inline std::vector<std::pair<std::size_t, std::size_t>> rpe_pairs_by_index(
+template <class Lazy = void>
+[[nodiscard]] std::vector<std::pair<std::size_t, std::size_t>> rpe_pairs_by_index(
     std::size_t n, std::size_t delta) {
   if (delta == 0) throw invalid_argument("rpe: delta in frames must be at least 1");
   std::vector<std::pair<std::size_t, std::size_t>> pairs;
@@ -182,7 +189,8 @@ enum class DeltaUnit {
 /// @param[in] delta_m path step (m, > 0)
 /// @return the index pairs
 /// @throws posefuse::invalid_argument when `delta_m` is not positive and finite
-[[nodiscard]] inline std::vector<std::pair<std::size_t, std::size_t>> rpe_pairs_by_path(
+template <class Lazy = void>
+[[nodiscard]] std::vector<std::pair<std::size_t, std::size_t>> rpe_pairs_by_path(
     std::span<const Eigen::Isometry3d> poses, double delta_m) {
   if (!(delta_m > 0.0) || !std::isfinite(delta_m)) {
     throw invalid_argument("rpe: delta in metres must be positive and finite");
@@ -231,7 +239,8 @@ struct RpeOptions {
 ///         delta (non-integer frames, non-positive), a degenerate alignment,
 ///         or when no pair exists for the delta (as evo; also for any delta
 ///         in frames of at least the number of poses, however large)
-[[nodiscard]] inline MetricResult rpe(const Trajectory& ref, const Trajectory& est,
+template <class Lazy = void>
+[[nodiscard]] MetricResult rpe(const Trajectory& ref, const Trajectory& est,
                                       const RpeOptions& options = {}) {
   if (ref.size() != est.size() || ref.empty()) {
     throw invalid_argument("rpe: reference has " + std::to_string(ref.size()) +

@@ -49,7 +49,8 @@ struct PlanarErrors {
 /// @throws posefuse::invalid_argument if either trajectory has a non-finite
 ///         entry, mismatched counts or decreasing stamps (see
 ///         PlanarTrajectory::validate_time_order)
-[[nodiscard]] inline PlanarErrors planar_errors(const PlanarTrajectory& track,
+template <class Lazy = void>
+[[nodiscard]] PlanarErrors planar_errors(const PlanarTrajectory& track,
                                                 const PlanarTrajectory& reference) {
   track.validate_time_order();
   reference.validate_time_order();
@@ -78,7 +79,8 @@ struct PlanarErrors {
 /// @return the distance (m)
 /// @throws posefuse::invalid_argument if the track is empty or its last
 ///         position, or `start`, is not finite
-[[nodiscard]] inline double loop_closure_error(const PlanarTrajectory& track,
+template <class Lazy = void>
+[[nodiscard]] double loop_closure_error(const PlanarTrajectory& track,
                                                const Eigen::Vector2d& start) {
   if (track.empty()) throw invalid_argument("loop_closure_error: the track has no pose");
   const Eigen::Vector3d& p = track.poses.back();
@@ -99,7 +101,8 @@ struct PlanarErrors {
 /// @throws posefuse::invalid_argument if a time is not finite, t_end_s <
 ///         t_begin_s, max_gap_s is negative, or the track is invalid (see
 ///         PlanarTrajectory::validate_time_order)
-[[nodiscard]] inline double time_without_pose(const PlanarTrajectory& track, double t_begin_s,
+template <class Lazy = void>
+[[nodiscard]] double time_without_pose(const PlanarTrajectory& track, double t_begin_s,
                                               double t_end_s, double max_gap_s) {
   if (!std::isfinite(t_begin_s) || !std::isfinite(t_end_s) || !(t_end_s >= t_begin_s))
     throw invalid_argument("time_without_pose: need finite t_begin_s <= t_end_s");

@@ -32,7 +32,8 @@ struct Statistics {
 /// @return rmse, mean, median, std (ddof = 0), min, max, sse and count
 /// @throws posefuse::invalid_argument when `errors` is empty or holds a
 ///         non-finite value
-[[nodiscard]] inline Statistics compute_statistics(std::span<const double> errors) {
+template <class Lazy = void>
+[[nodiscard]] Statistics compute_statistics(std::span<const double> errors) {
   if (errors.empty()) throw invalid_argument("compute_statistics: no errors to summarise");
   Statistics s;
   s.count = errors.size();

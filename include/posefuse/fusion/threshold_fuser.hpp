@@ -113,7 +113,4 @@ class ThresholdFuser {
   T threshold_;
 };
 
-static_assert(Stage<ThresholdFuser<double>>);
-static_assert(Stage<ThresholdFuser<float>>);
-
 }  // namespace posefuse

@@ -47,7 +47,8 @@ namespace detail::traj_io {
 /// `long` stamps: for each short stamp, the first argmin of
 /// |(long + offset) - short|, kept when <= max_diff. Binary search replaces
 /// numpy's linear scan; ties resolve to the first index as np.argmin does.
-inline void match_nearest(std::span<const double> short_stamps, std::span<const double> long_stamps,
+template <class Lazy = void>
+void match_nearest(std::span<const double> short_stamps, std::span<const double> long_stamps,
                           double max_diff, double offset, std::vector<std::size_t>& short_ids,
                           std::vector<std::size_t>& long_ids) {
   std::vector<double> shifted(long_stamps.begin(), long_stamps.end());
@@ -79,7 +80,8 @@ inline void match_nearest(std::span<const double> short_stamps, std::span<const 
   }
 }
 
-inline void check_stamps(std::span<const double> stamps, const char* which) {
+template <class Lazy = void>
+void check_stamps(std::span<const double> stamps, const char* which) {
   for (std::size_t k = 0; k < stamps.size(); ++k) {
     if (!std::isfinite(stamps[k]) || (k > 0 && stamps[k] < stamps[k - 1])) {
       throw invalid_argument(std::string("associate: ") + which +
@@ -100,7 +102,8 @@ inline void check_stamps(std::span<const double> stamps, const char* which) {
 /// @throws posefuse::invalid_argument for unsorted or non-finite stamps, a
 ///         negative or non-finite `max_diff_s`, a non-finite offset, or when
 ///         no pair matches
-[[nodiscard]] inline Association associate(std::span<const double> ref_stamps,
+template <class Lazy = void>
+[[nodiscard]] Association associate(std::span<const double> ref_stamps,
                                            std::span<const double> est_stamps,
                                            double max_diff_s = 0.01, double offset_est_s = 0.0) {
   if (!(max_diff_s >= 0.0) || !std::isfinite(max_diff_s)) {
@@ -141,7 +144,8 @@ inline void check_stamps(std::span<const double> stamps, const char* which) {
 ///         time frames (the offset is not applied to them)
 /// @throws posefuse::invalid_argument when either trajectory fails
 ///         `validate()`, for bad parameters, or when nothing matches
-[[nodiscard]] inline AssociatedTrajectories associate(const Trajectory& ref, const Trajectory& est,
+template <class Lazy = void>
+[[nodiscard]] AssociatedTrajectories associate(const Trajectory& ref, const Trajectory& est,
                                                       double max_diff_s = 0.01,
                                                       double offset_est_s = 0.0) {
   ref.validate();

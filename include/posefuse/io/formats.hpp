@@ -23,7 +23,8 @@ enum class Format {
 
 /// Parses "kitti" or "tum".
 /// @throws posefuse::invalid_argument for any other text
-[[nodiscard]] inline Format parse_format(std::string_view name) {
+template <class Lazy = void>
+[[nodiscard]] Format parse_format(std::string_view name) {
   if (name == "kitti") return Format::kKitti;
   if (name == "tum") return Format::kTum;
   throw invalid_argument("unknown trajectory format '" + std::string(name) +
@@ -43,7 +44,8 @@ enum class Format {
 /// @return the trajectory
 /// @throws posefuse::invalid_argument when a times file is given for TUM
 /// @throws posefuse::io_error (file:line) for any unreadable or malformed input
-[[nodiscard]] inline Trajectory read_trajectory(
+template <class Lazy = void>
+[[nodiscard]] Trajectory read_trajectory(
     const std::filesystem::path& file, Format format,
     const std::optional<std::filesystem::path>& times_file = std::nullopt,
     const ReadOptions& options = {}) {
@@ -58,7 +60,8 @@ enum class Format {
 /// `write_kitti_times` for the stamps).
 /// @throws posefuse::invalid_argument when `traj` fails `validate()`
 /// @throws posefuse::io_error when the file cannot be written
-inline void write_trajectory(const std::filesystem::path& file, const Trajectory& traj,
+template <class Lazy = void>
+void write_trajectory(const std::filesystem::path& file, const Trajectory& traj,
                              Format format) {
   if (format == Format::kTum) {
     write_tum(file, traj);

@@ -35,7 +35,8 @@ struct NumberedRows {
   std::vector<std::size_t> lines;
 };
 
-inline NumberedRows<Eigen::Isometry3d> read_kitti_rows(const std::filesystem::path& file,
+template <class Lazy = void>
+NumberedRows<Eigen::Isometry3d> read_kitti_rows(const std::filesystem::path& file,
                                                        const ReadOptions& options) {
   LineReader reader(file);
   NumberedRows<Eigen::Isometry3d> rows;
@@ -56,7 +57,8 @@ inline NumberedRows<Eigen::Isometry3d> read_kitti_rows(const std::filesystem::pa
   return rows;
 }
 
-inline NumberedRows<double> read_stamp_rows(const std::filesystem::path& file) {
+template <class Lazy = void>
+NumberedRows<double> read_stamp_rows(const std::filesystem::path& file) {
   LineReader reader(file);
   NumberedRows<double> rows;
   std::string line;
@@ -87,7 +89,8 @@ inline NumberedRows<double> read_stamp_rows(const std::filesystem::path& file) {
 ///         fails or a line is longer than kMaxLineBytes; and (file only)
 ///         when the path cannot be accessed or the file has no stamp ("no
 ///         timestamps")
-[[nodiscard]] inline std::vector<double> read_kitti_times(const std::filesystem::path& file) {
+template <class Lazy = void>
+[[nodiscard]] std::vector<double> read_kitti_times(const std::filesystem::path& file) {
   return detail::traj_io::read_stamp_rows(file).values;
 }
 
@@ -110,7 +113,8 @@ inline NumberedRows<double> read_stamp_rows(const std::filesystem::path& file) {
 ///         or a line is longer than kMaxLineBytes; and (file only) when a
 ///         path cannot be accessed or a file has no pose ("no poses") or no
 ///         stamp ("no timestamps")
-[[nodiscard]] inline Trajectory read_kitti(
+template <class Lazy = void>
+[[nodiscard]] Trajectory read_kitti(
     const std::filesystem::path& poses_file,
     const std::optional<std::filesystem::path>& times_file = std::nullopt,
     const ReadOptions& options = {}) {
@@ -149,7 +153,8 @@ inline NumberedRows<double> read_stamp_rows(const std::filesystem::path& file) {
 /// @param[in] traj the trajectory
 /// @throws posefuse::invalid_argument when `traj` fails `validate()`
 /// @throws posefuse::io_error when the file cannot be written
-inline void write_kitti(const std::filesystem::path& file, const Trajectory& traj) {
+template <class Lazy = void>
+void write_kitti(const std::filesystem::path& file, const Trajectory& traj) {
   traj.validate();
   std::ofstream out = detail::traj_io::open_output(file);
   for (const Eigen::Isometry3d& T : traj.poses) {
@@ -169,7 +174,8 @@ inline void write_kitti(const std::filesystem::path& file, const Trajectory& tra
 /// shortest round-trip text).
 /// @throws posefuse::invalid_argument when `traj` fails `validate()`
 /// @throws posefuse::io_error when the file cannot be written
-inline void write_kitti_times(const std::filesystem::path& file, const Trajectory& traj) {
+template <class Lazy = void>
+void write_kitti_times(const std::filesystem::path& file, const Trajectory& traj) {
   traj.validate();
   std::ofstream out = detail::traj_io::open_output(file);
   for (const double t : traj.t_s) out << detail::traj_io::format_number(t) << '\n';

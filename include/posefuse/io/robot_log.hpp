@@ -67,7 +67,8 @@ namespace posefuse {
 /// @throws posefuse::io_error (file:line) for a missing file, an unknown or
 ///         duplicate key, a line that is not `key value`, a bad, non-finite or
 ///         non-positive value, alpha outside (0, 1), or a missing key
-[[nodiscard]] inline RobotLogParams read_robot_params(const std::filesystem::path& file) {
+template <class Lazy = void>
+[[nodiscard]] RobotLogParams read_robot_params(const std::filesystem::path& file) {
   RobotLogParams p;
   struct Key {
     std::string_view name;
@@ -127,7 +128,8 @@ namespace posefuse {
 ///         groundtruth.csv none, a path cannot be accessed (e.g. a name too
 ///         long), a read fails or a line is longer than kMaxLineBytes, and
 ///         for the errors of check_robot_log()
-[[nodiscard]] inline RobotLog read_robot_log(const std::filesystem::path& dir) {
+template <class Lazy = void>
+[[nodiscard]] RobotLog read_robot_log(const std::filesystem::path& dir) {
   using detail::CsvLine;
   if (!std::filesystem::is_directory(detail::checked_status(dir)))
     throw io_error(dir, "log folder does not exist");
@@ -203,7 +205,8 @@ namespace posefuse {
 /// @param[in] dir destination folder (created if absent; files overwritten)
 /// @param[in] log the log; groundtruth.csv is written only when non-empty
 /// @throws posefuse::io_error when a file cannot be written
-inline void write_robot_log(const std::filesystem::path& dir, const RobotLog& log) {
+template <class Lazy = void>
+void write_robot_log(const std::filesystem::path& dir, const RobotLog& log) {
   using detail::fmt;
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);

@@ -59,13 +59,15 @@ struct RobotLogLimits {
 
 namespace detail {
 
-inline std::filesystem::path log_file(const std::filesystem::path& dir, const char* name) {
+template <class Lazy = void>
+std::filesystem::path log_file(const std::filesystem::path& dir, const char* name) {
   return dir.empty() ? std::filesystem::path(name) : dir / name;
 }
 
 /// `v` in fixed notation with `prec` decimals, never truncated (1e300 takes
 /// 301 digits) and locale-free ("C" formatting of std::to_chars).
-inline std::string num_text(double v, int prec) {
+template <class Lazy = void>
+std::string num_text(double v, int prec) {
   if (!std::isfinite(v)) return std::isnan(v) ? "nan" : v > 0 ? "inf" : "-inf";
   // Digits before the point: at most 309 for a double; after it: prec.
   std::string s(std::size_t(330 + std::max(0, prec)), '\0');
@@ -75,7 +77,8 @@ inline std::string num_text(double v, int prec) {
   return s;
 }
 
-inline double median_of(std::vector<double> v) {
+template <class Lazy = void>
+double median_of(std::vector<double> v) {
   if (v.empty()) return 0;
   const auto mid = v.begin() + std::ptrdiff_t(v.size() / 2);
   std::nth_element(v.begin(), mid, v.end());
@@ -89,7 +92,8 @@ inline double median_of(std::vector<double> v) {
 /// @param[in] r the SLAM sample (its quaternion need not be normalised)
 /// @param[in] max_deg tilt limit (deg)
 /// @return true when tilted; false for a zero or NaN quaternion
-[[nodiscard]] inline bool slam_pose_tilted(const SlamSample& r, double max_deg = 20.0) noexcept {
+template <class Lazy = void>
+[[nodiscard]] bool slam_pose_tilted(const SlamSample& r, double max_deg = 20.0) noexcept {
   const auto& q = r.orientation.coeffs();  // x, y, z, w
   const double n2 = q(0) * q(0) + q(1) * q(1) + q(2) * q(2) + q(3) * q(3);
   if (!(n2 > 0)) return false;
@@ -100,7 +104,8 @@ inline double median_of(std::vector<double> v) {
 /// Throws when one wheels.csv increment implies more than the speed limit.
 /// @param[in] lines 1-based line of each row (empty: "data row K" is named)
 /// @throws posefuse::io_error (file:line) naming wheel, ticks, time and speed
-inline void check_wheel_increments(const std::vector<WheelSample>& w, const RobotLogParams& p,
+template <class Lazy = void>
+void check_wheel_increments(const std::vector<WheelSample>& w, const RobotLogParams& p,
                                    const std::filesystem::path& file,
                                    std::span<const std::size_t> lines = {},
                                    const RobotLogLimits& lim = {}) {
@@ -132,7 +137,8 @@ inline void check_wheel_increments(const std::vector<WheelSample>& w, const Robo
 }
 
 /// Throws unless the first rows of imu.csv read gravity as +z (REP-103).
-inline void check_imu_axes(const std::vector<ImuSample>& imu, const std::filesystem::path& file,
+template <class Lazy = void>
+void check_imu_axes(const std::vector<ImuSample>& imu, const std::filesystem::path& file,
                            const RobotLogLimits& lim = {}) {
   const std::size_t n = std::min(imu.size(), lim.imu_rest_rows);
   if (n == 0) return;
@@ -155,7 +161,8 @@ inline void check_imu_axes(const std::vector<ImuSample>& imu, const std::filesys
 /// Counts the valid SLAM poses tilted more than the limit from z-up.
 /// @return the count; throws when it is more than half of the valid poses
 /// @throws posefuse::io_error naming the file
-inline int check_slam_tilt(const std::vector<SlamSample>& slam, const std::filesystem::path& file,
+template <class Lazy = void>
+int check_slam_tilt(const std::vector<SlamSample>& slam, const std::filesystem::path& file,
                            const RobotLogLimits& lim = {}) {
   int valid = 0, tilted = 0;
   for (const SlamSample& r : slam) {
@@ -173,7 +180,8 @@ inline int check_slam_tilt(const std::vector<SlamSample>& slam, const std::files
 
 /// Throws when a stream's time span does not match wheels.csv's (another
 /// unit or epoch; see the file comment).
-inline void check_stream_clocks(const RobotLog& log, const std::filesystem::path& dir,
+template <class Lazy = void>
+void check_stream_clocks(const RobotLog& log, const std::filesystem::path& dir,
                                 const RobotLogLimits& lim = {}) {
   if (log.wheels.size() < 2) return;
   const double wa = double(log.wheels.front().t_ns), wb = double(log.wheels.back().t_ns);
@@ -207,7 +215,8 @@ inline void check_stream_clocks(const RobotLog& log, const std::filesystem::path
 
 /// Warnings about the encoder path: turning far more than travelling, front
 /// and back wheels of a side disagreeing, driving mostly backwards.
-[[nodiscard]] inline std::vector<std::string> wheel_path_warnings(const std::vector<WheelSample>& w,
+template <class Lazy = void>
+[[nodiscard]] std::vector<std::string> wheel_path_warnings(const std::vector<WheelSample>& w,
                                                                   const RobotLogParams& p,
                                                                   const std::filesystem::path& file) {
   std::vector<std::string> out;
@@ -256,7 +265,8 @@ inline void check_stream_clocks(const RobotLog& log, const std::filesystem::path
 /// @param[in] dir its folder, for the file names in messages (empty: bare names)
 /// @return the warnings, each starting with the file name
 /// @throws posefuse::io_error for the errors of the file comment
-[[nodiscard]] inline std::vector<std::string> check_robot_log(const RobotLog& log,
+template <class Lazy = void>
+[[nodiscard]] std::vector<std::string> check_robot_log(const RobotLog& log,
                                                               const std::filesystem::path& dir = {},
                                                               const RobotLogLimits& lim = {}) {
   std::vector<std::string> warnings;

@@ -37,7 +37,8 @@ namespace posefuse {
 ///         read fails or a line is longer than kMaxLineBytes; and (file
 ///         only) when the path cannot be accessed or the file has no pose
 ///         ("no poses")
-[[nodiscard]] inline Trajectory read_tum(const std::filesystem::path& file,
+template <class Lazy = void>
+[[nodiscard]] Trajectory read_tum(const std::filesystem::path& file,
                                          const ReadOptions& options = {}) {
   detail::LineReader reader(file);
   Trajectory traj;
@@ -76,7 +77,8 @@ namespace posefuse {
 /// @param[in] traj the trajectory
 /// @throws posefuse::invalid_argument when `traj` fails `validate()`
 /// @throws posefuse::io_error when the file cannot be written
-inline void write_tum(const std::filesystem::path& file, const Trajectory& traj) {
+template <class Lazy = void>
+void write_tum(const std::filesystem::path& file, const Trajectory& traj) {
   traj.validate();
   std::ofstream out = detail::traj_io::open_output(file);
   out << "# timestamp tx ty tz qx qy qz qw\n";

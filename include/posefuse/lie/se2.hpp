@@ -246,7 +246,4 @@ class SE2 {
 using SE2d = SE2<double>;  ///< SE(2) in double
 using SE2f = SE2<float>;   ///< SE(2) in float
 
-static_assert(Manifold<SE2<double>>);
-static_assert(Manifold<SE2<float>>);
-
 }  // namespace posefuse

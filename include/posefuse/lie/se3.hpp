@@ -266,7 +266,4 @@ class SE3 {
 using SE3d = SE3<double>;  ///< SE(3) in double
 using SE3f = SE3<float>;   ///< SE(3) in float
 
-static_assert(Manifold<SE3<double>>);
-static_assert(Manifold<SE3<float>>);
-
 }  // namespace posefuse

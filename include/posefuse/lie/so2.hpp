@@ -197,7 +197,4 @@ class SO2 {
 using SO2d = SO2<double>;  ///< SO(2) in double
 using SO2f = SO2<float>;   ///< SO(2) in float
 
-static_assert(Manifold<SO2<double>>);
-static_assert(Manifold<SO2<float>>);
-
 }  // namespace posefuse

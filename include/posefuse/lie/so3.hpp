@@ -256,7 +256,4 @@ class SO3 {
 using SO3d = SO3<double>;  ///< SO(3) in double
 using SO3f = SO3<float>;   ///< SO(3) in float
 
-static_assert(Manifold<SO3<double>>);
-static_assert(Manifold<SO3<float>>);
-
 }  // namespace posefuse

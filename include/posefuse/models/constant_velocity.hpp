@@ -63,7 +63,4 @@ class ConstantVelocity2 {
   T q_;
 };
 
-static_assert(MotionModel<ConstantVelocity2<double>>);
-static_assert(MotionModel<ConstantVelocity2<float>>);
-
 }  // namespace posefuse

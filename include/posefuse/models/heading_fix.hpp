@@ -46,7 +46,4 @@ class HeadingFix {
   T var_;
 };
 
-static_assert(MeasurementModel<HeadingFix<double>>);
-static_assert(MeasurementModel<HeadingFix<float>>);
-
 }  // namespace posefuse

@@ -45,7 +45,4 @@ class PlanarDisplacement {
   Matrix R_;
 };
 
-static_assert(MotionModel<PlanarDisplacement<double>>);
-static_assert(MotionModel<PlanarDisplacement<float>>);
-
 }  // namespace posefuse

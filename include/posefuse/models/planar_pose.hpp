@@ -35,7 +35,4 @@ struct PlanarPose {
   [[nodiscard]] Tangent vector() const { return {x, y, theta}; }
 };
 
-static_assert(State<PlanarPose<double>>);
-static_assert(State<PlanarPose<float>>);
-
 }  // namespace posefuse

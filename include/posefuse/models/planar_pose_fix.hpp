@@ -58,7 +58,4 @@ class PlanarPoseFix {
   Noise R_;
 };
 
-static_assert(MeasurementModel<PlanarPoseFix<double>>);
-static_assert(MeasurementModel<PlanarPoseFix<float>>);
-
 }  // namespace posefuse

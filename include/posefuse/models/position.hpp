@@ -46,7 +46,4 @@ class PositionFix {
   Noise Q_;
 };
 
-static_assert(MeasurementModel<PositionFix<2>>);
-static_assert(MeasurementModel<PositionFix<4, 2, float>>);
-
 }  // namespace posefuse

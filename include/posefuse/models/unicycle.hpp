@@ -131,7 +131,4 @@ struct Unicycle {
   }
 };
 
-static_assert(check_motion_model<Unicycle<double>>());
-static_assert(MotionModel<Unicycle<float>>);
-
 }  // namespace posefuse

@@ -103,6 +103,7 @@ class CompassStage {
 
   /// @param[in] in IMU sample with roll/pitch (rad)
   /// @return roll, pitch from `in`, yaw from the calibrated magnetometer
+  template <class Lazy = void>  // compiled only where called (compile cost)
   [[nodiscard]] Attitude operator()(const TiltedImu& in) noexcept {
     Attitude out{in.imu.t_ns, in.tilt.roll, in.tilt.pitch, last_yaw_, in.status};
     const Eigen::Vector3d m = cal_.apply(in.imu.mag_uT);

@@ -75,6 +75,7 @@ class DeadReckoning {
   /// @param[in] dtheta_rad heading change, rad
   /// @param[in] cov_u covariance of (ds_m, dtheta_rad)
   /// @return kOk, or kNonFinite (pose and covariance untouched)
+  template <class Lazy = void>  // compiled only where called (compile cost)
   [[nodiscard]] SampleStatus step(double ds_m, double dtheta_rad, const Eigen::Matrix2d& cov_u) noexcept {
     if (!std::isfinite(ds_m) || !std::isfinite(dtheta_rad) || !cov_u.allFinite())
       return SampleStatus::kNonFinite;
@@ -88,6 +89,7 @@ class DeadReckoning {
   /// Stage call: integrates `m.ds_m`, `m.dtheta_rad` with `m.cov`.
   /// @return pose and covariance after the step, stamped m.t_ns; status kNonFinite
   ///         if the motion was not finite (pose held), else m.status
+  template <class Lazy = void>  // compiled only where called (compile cost)
   [[nodiscard]] PlanarPoseEstimate operator()(const BodyMotion& m) noexcept {
     const SampleStatus st = step(m.ds_m, m.dtheta_rad, m.cov);
     PlanarPoseEstimate out;

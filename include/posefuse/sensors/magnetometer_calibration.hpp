@@ -53,6 +53,7 @@ struct MagnetometerCalibration {
   /// The calibrated field \f$ S (m - h) \f$.
   /// @param[in] m raw reading, µT (sensor frame)
   /// @return calibrated reading, µT (sensor frame)
+  template <class Lazy = void>  // compiled only where called (compile cost)
   [[nodiscard]] Eigen::Vector3d apply(const Eigen::Vector3d& m) const {
     return soft_iron * (m - hard_iron);
   }

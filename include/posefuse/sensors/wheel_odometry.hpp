@@ -206,6 +206,7 @@ class DiffDriveOdometry {
   /// @return motion since the previous sample
   /// @throws posefuse::invalid_argument if a count is not finite, or the stamp
   ///         is not greater than the previous one (state untouched)
+  template <class Lazy = void>  // compiled only where called (compile cost)
   [[nodiscard]] BodyMotion operator()(const StampedSideTicks& in) {
     if (!std::isfinite(in.ticks.left) || !std::isfinite(in.ticks.right))
       throw invalid_argument("posefuse: DiffDriveOdometry got a non-finite count");
@@ -260,6 +261,7 @@ class WheelOdometry {
       : diff_(params, noise) {}
 
   /// @throws posefuse::invalid_argument on a non-increasing time stamp
+  template <class Lazy = void>  // compiled only where called (compile cost)
   [[nodiscard]] BodyMotion operator()(const WheelSample& in) { return diff_(average_(in)); }
 
   /// Forgets the previous sample.

@@ -30,7 +30,8 @@ namespace detail {
 /// @throws posefuse::io_error naming `file` when its status cannot be
 ///         determined, e.g. a path component longer than the system allows
 ///         (ENAMETOOLONG) or a folder without search permission
-[[nodiscard]] inline std::filesystem::file_status checked_status(
+template <class Lazy = void>
+[[nodiscard]] std::filesystem::file_status checked_status(
     const std::filesystem::path& file) {
   std::error_code ec;
   const std::filesystem::file_status st = std::filesystem::status(file, ec);
@@ -102,7 +103,8 @@ class LineReader {
 /// Opens `file` for writing (truncating it) with the classic "C" locale, so
 /// that nothing written depends on the global locale (no digit grouping).
 /// @throws posefuse::io_error when it cannot be opened
-[[nodiscard]] inline std::ofstream open_output_file(const std::filesystem::path& file) {
+template <class Lazy = void>
+[[nodiscard]] std::ofstream open_output_file(const std::filesystem::path& file) {
   std::ofstream out;
   out.imbue(std::locale::classic());
   out.open(file, std::ios::out | std::ios::binary | std::ios::trunc);

@@ -25,13 +25,15 @@ namespace posefuse {
 
 namespace detail {
 
-inline std::string_view trim(std::string_view s) noexcept {
+template <class Lazy = void>
+std::string_view trim(std::string_view s) noexcept {
   while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
   while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
   return s;
 }
 
-inline std::string lower(std::string_view s) {
+template <class Lazy = void>
+std::string lower(std::string_view s) {
   std::string r(s);
   for (char& c : r) c = (c >= 'A' && c <= 'Z') ? char(c - 'A' + 'a') : c;
   return r;
@@ -41,7 +43,8 @@ inline std::string lower(std::string_view s) {
 /// and `#` lines.
 /// @throws posefuse::io_error for a missing or inaccessible file, a read
 ///         error, or a line longer than kMaxLineBytes
-inline std::vector<std::pair<std::size_t, std::string>> read_content_lines(
+template <class Lazy = void>
+std::vector<std::pair<std::size_t, std::string>> read_content_lines(
     const std::filesystem::path& file) {
   if (checked_status(file).type() == std::filesystem::file_type::not_found)
     throw io_error(file, "required file is missing");
@@ -56,7 +59,8 @@ inline std::vector<std::pair<std::size_t, std::string>> read_content_lines(
   return lines;
 }
 
-inline std::vector<std::string_view> split_csv(std::string_view s) {
+template <class Lazy = void>
+std::vector<std::string_view> split_csv(std::string_view s) {
   std::vector<std::string_view> out;
   for (;;) {
     const std::size_t c = s.find(',');
@@ -119,7 +123,8 @@ class CsvLine {
 };
 
 /// True when a line is the file's column names (an uncommented header).
-inline bool is_column_header(std::string_view text, std::span<const std::string_view> names) {
+template <class Lazy = void>
+bool is_column_header(std::string_view text, std::span<const std::string_view> names) {
   const auto f = split_csv(text);
   if (f.size() != names.size()) return false;
   for (std::size_t i = 0; i < f.size(); ++i) {
@@ -153,14 +158,16 @@ std::vector<Record> read_csv(const std::filesystem::path& file,
   return out;
 }
 
-inline std::string fmt(double v) {
+template <class Lazy = void>
+std::string fmt(double v) {
   std::array<char, 64> buf{};
   const auto r = std::to_chars(buf.data(), buf.data() + buf.size(), v);  // shortest round-trip
   return std::string(buf.data(), r.ptr);
 }
 
 /// Opens `file` for writing, locale-free (see open_output_file).
-inline std::ofstream open_for_writing(const std::filesystem::path& file) {
+template <class Lazy = void>
+std::ofstream open_for_writing(const std::filesystem::path& file) {
   return open_output_file(file);
 }
 

@@ -28,13 +28,15 @@ namespace posefuse::detail::traj_io {
 
 /// Opens `file` for writing (truncating it), locale-free (see open_output_file).
 /// @throws posefuse::io_error when it cannot be opened
-[[nodiscard]] inline std::ofstream open_output(const std::filesystem::path& file) {
+template <class Lazy = void>
+[[nodiscard]] std::ofstream open_output(const std::filesystem::path& file) {
   return open_output_file(file);
 }
 
 /// Flushes `out` and reports a failed write.
 /// @throws posefuse::io_error when any write to `file` failed
-inline void finish_output(std::ofstream& out, const std::filesystem::path& file) {
+template <class Lazy = void>
+void finish_output(std::ofstream& out, const std::filesystem::path& file) {
   out.flush();
   if (!out) throw io_error(file, "write failed");
 }
@@ -44,7 +46,8 @@ inline void finish_output(std::ofstream& out, const std::filesystem::path& file)
 }
 
 /// True for a line that is empty, all whitespace, or a '#' comment.
-[[nodiscard]] inline bool is_blank_or_comment(std::string_view line) noexcept {
+template <class Lazy = void>
+[[nodiscard]] bool is_blank_or_comment(std::string_view line) noexcept {
   for (const char c : line) {
     if (is_space(c)) continue;
     return c == '#';
@@ -53,7 +56,8 @@ inline void finish_output(std::ofstream& out, const std::filesystem::path& file)
 }
 
 /// Splits a line at runs of whitespace; the views point into `line`.
-[[nodiscard]] inline std::vector<std::string_view> split_whitespace(std::string_view line) {
+template <class Lazy = void>
+[[nodiscard]] std::vector<std::string_view> split_whitespace(std::string_view line) {
   std::vector<std::string_view> tokens;
   std::size_t i = 0;
   while (i < line.size()) {
@@ -68,7 +72,8 @@ inline void finish_output(std::ofstream& out, const std::filesystem::path& file)
 /// Parses a whole token as a finite double (decimal or scientific; a
 /// leading '+' is accepted).
 /// @throws posefuse::io_error naming file, line and 1-based column
-[[nodiscard]] inline double parse_number(std::string_view token, const std::filesystem::path& file,
+template <class Lazy = void>
+[[nodiscard]] double parse_number(std::string_view token, const std::filesystem::path& file,
                                          std::size_t line, std::size_t column) {
   std::string_view digits = token;
   if (digits.size() > 1 && digits.front() == '+' && digits[1] != '-' && digits[1] != '+') {
@@ -98,7 +103,8 @@ inline void finish_output(std::ofstream& out, const std::filesystem::path& file)
 /// Tokenises a data line, checks it has exactly `expected` numbers and parses them.
 /// @param[in] what short description of the row layout for the message
 /// @throws posefuse::io_error on a wrong column count or a bad number
-[[nodiscard]] inline std::vector<double> parse_row(std::string_view line, std::size_t expected,
+template <class Lazy = void>
+[[nodiscard]] std::vector<double> parse_row(std::string_view line, std::size_t expected,
                                                    std::string_view what,
                                                    const std::filesystem::path& file,
                                                    std::size_t line_no) {
@@ -116,7 +122,8 @@ inline void finish_output(std::ofstream& out, const std::filesystem::path& file)
 }
 
 /// Shortest decimal text that parses back to exactly `value` (std::to_chars).
-[[nodiscard]] inline std::string format_number(double value) {
+template <class Lazy = void>
+[[nodiscard]] std::string format_number(double value) {
   char buf[64];
   const auto [ptr, ec] = std::to_chars(buf, buf + sizeof(buf), value);
   (void)ec;  // 64 chars always suffice for a double
@@ -154,7 +161,8 @@ template <class Lazy = void>
 
 /// Checks a quaternion's norm and returns it normalised.
 /// @throws posefuse::io_error for a zero or clearly non-unit quaternion
-[[nodiscard]] inline Eigen::Quaterniond checked_quaternion(const Eigen::Quaterniond& q,
+template <class Lazy = void>
+[[nodiscard]] Eigen::Quaterniond checked_quaternion(const Eigen::Quaterniond& q,
                                                            double tolerance,
                                                            const std::filesystem::path& file,
                                                            std::size_t line) {
