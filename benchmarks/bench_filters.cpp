@@ -15,6 +15,19 @@
 //                                    fixed-size Eigen (G, H multiplied, S inverted)
 //   BM_Seed000Ekf_Step/dynamic       the same textbook step with Eigen::MatrixXd
 //   BM_ConstantVelocityEkf_Step      4-D constant-velocity predict + 2-D fix
+// The cost of the PSD checks inside those steps (core/gaussian.hpp's
+// criterion; Ekf checks the predicted covariance every predict and the
+// posterior whenever the gain is recomputed), without a knob on Ekf:
+//   .../<step>_plus_check            the same step plus one more
+//                                    is_positive_semidefinite() of the filter's
+//                                    covariance, as the step itself does it:
+//                                    the difference to <step> is the marginal
+//                                    cost of one check inside the step
+//   BM_PsdCheck/<n>                  is_positive_semidefinite() alone on the
+//                                    covariances those filters produce
+//   BM_PsdCheck_Reference/<n>        the same on the completely pivoted LDLT
+//                                    alone (detail::psd_reference), i.e. without
+//                                    the fast path
 // Inputs are generated once outside the timed loop; each iteration runs one
 // frame of a 1024-frame sequence.
 #include <Eigen/Dense>
@@ -23,6 +36,7 @@
 #include <posefuse/models/constant_velocity.hpp>
 #include <posefuse/models/planar_displacement.hpp>
 #include <posefuse/models/position.hpp>
+#include <array>
 #include <random>
 #include <vector>
 
@@ -66,6 +80,24 @@ void BM_Seed000Ekf_Step_posefuse(benchmark::State& state) {
 }
 BENCHMARK(BM_Seed000Ekf_Step_posefuse)->Name("BM_Seed000Ekf_Step/posefuse");
 
+void BM_Seed000Ekf_Step_posefuse_plus_check(benchmark::State& state) {
+  const Frames& f = frames();
+  posefuse::Ekf<posefuse::PlanarDisplacement<double>, posefuse::PositionFix<2>> ekf(
+      posefuse::PlanarDisplacement<double>::from_sigmas(0.1, 0.1),
+      posefuse::PositionFix<2>::isotropic(0.5));
+  ekf.reset(f.z[0], Eigen::Matrix2d::Identity());
+  std::size_t k = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(ekf.predict(f.u[k], 1.0));
+    benchmark::DoNotOptimize(posefuse::is_positive_semidefinite(ekf.covariance()));
+    auto r = ekf.update<0>(f.z[k]);
+    benchmark::DoNotOptimize(r);
+    k = (k + 1) & 1023;
+  }
+  benchmark::DoNotOptimize(ekf.state());
+}
+BENCHMARK(BM_Seed000Ekf_Step_posefuse_plus_check)->Name("BM_Seed000Ekf_Step/posefuse_plus_check");
+
 void BM_Seed000Ekf_Step_posefuse_recompute(benchmark::State& state) {
   const Frames& f = frames();
   const posefuse::PositionFix<2> fix = posefuse::PositionFix<2>::isotropic(0.5);
@@ -82,6 +114,25 @@ void BM_Seed000Ekf_Step_posefuse_recompute(benchmark::State& state) {
   benchmark::DoNotOptimize(ekf.state());
 }
 BENCHMARK(BM_Seed000Ekf_Step_posefuse_recompute)->Name("BM_Seed000Ekf_Step/posefuse_recompute");
+
+void BM_Seed000Ekf_Step_posefuse_recompute_plus_check(benchmark::State& state) {
+  const Frames& f = frames();
+  const posefuse::PositionFix<2> fix = posefuse::PositionFix<2>::isotropic(0.5);
+  posefuse::Ekf<posefuse::PlanarDisplacement<double>, posefuse::PositionFix<2>> ekf(
+      posefuse::PlanarDisplacement<double>::from_sigmas(0.1, 0.1), fix);
+  ekf.reset(f.z[0], Eigen::Matrix2d::Identity());
+  std::size_t k = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(ekf.predict(f.u[k], 1.0));
+    benchmark::DoNotOptimize(posefuse::is_positive_semidefinite(ekf.covariance()));
+    auto r = ekf.update_with(fix, f.z[k]);
+    benchmark::DoNotOptimize(r);
+    k = (k + 1) & 1023;
+  }
+  benchmark::DoNotOptimize(ekf.state());
+}
+BENCHMARK(BM_Seed000Ekf_Step_posefuse_recompute_plus_check)
+    ->Name("BM_Seed000Ekf_Step/posefuse_recompute_plus_check");
 
 void BM_Seed000Ekf_Step_naive_fixed(benchmark::State& state) {
   const Frames& f = frames();
@@ -147,5 +198,85 @@ void BM_ConstantVelocityEkf_Step(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_ConstantVelocityEkf_Step);
+
+void BM_ConstantVelocityEkf_Step_plus_check(benchmark::State& state) {
+  const Frames& f = frames();
+  posefuse::Ekf<posefuse::ConstantVelocity2<double>, posefuse::PositionFix<4>> ekf(
+      posefuse::ConstantVelocity2<double>(1.0), posefuse::PositionFix<4>::isotropic(0.5));
+  Eigen::Vector4d x0;
+  x0 << f.z[0], 0, 0;
+  ekf.reset(x0, Eigen::Matrix4d::Identity());
+  std::size_t k = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(ekf.predict(posefuse::NoControl{}, 0.1));
+    benchmark::DoNotOptimize(posefuse::is_positive_semidefinite(ekf.covariance()));
+    auto r = ekf.update<0>(f.z[k]);
+    benchmark::DoNotOptimize(r);
+    k = (k + 1) & 1023;
+  }
+}
+BENCHMARK(BM_ConstantVelocityEkf_Step_plus_check)->Name("BM_ConstantVelocityEkf_Step_plus_check");
+
+// Covariances as the filters above produce them (predicted and posterior,
+// the first 128 steps of each, so they still change), cycled.
+template <int N>
+const std::vector<Eigen::Matrix<double, N, N>>& filter_covariances() {
+  static const std::vector<Eigen::Matrix<double, N, N>> out = [] {
+    std::vector<Eigen::Matrix<double, N, N>> v;
+    const Frames& f = frames();
+    if constexpr (N == 2) {
+      const posefuse::PositionFix<2> fix = posefuse::PositionFix<2>::isotropic(0.5);
+      posefuse::Ekf<posefuse::PlanarDisplacement<double>, posefuse::PositionFix<2>> ekf(
+          posefuse::PlanarDisplacement<double>::from_sigmas(0.1, 0.1), fix);
+      ekf.reset(f.z[0], Eigen::Matrix2d::Identity());
+      for (std::size_t k = 0; k < 128; ++k) {
+        (void)ekf.predict(f.u[k], 1.0);
+        v.push_back(ekf.covariance());
+        (void)ekf.update_with(fix, f.z[k]);
+        v.push_back(ekf.covariance());
+      }
+    } else {
+      static_assert(N == 4);
+      const posefuse::PositionFix<4> fix = posefuse::PositionFix<4>::isotropic(0.5);
+      posefuse::Ekf<posefuse::ConstantVelocity2<double>, posefuse::PositionFix<4>> ekf(
+          posefuse::ConstantVelocity2<double>(1.0), fix);
+      Eigen::Vector4d x0;
+      x0 << f.z[0], 0, 0;
+      ekf.reset(x0, Eigen::Matrix4d::Identity());
+      for (std::size_t k = 0; k < 128; ++k) {
+        (void)ekf.predict(posefuse::NoControl{}, 0.1);
+        v.push_back(ekf.covariance());
+        (void)ekf.update_with(fix, f.z[k]);
+        v.push_back(ekf.covariance());
+      }
+    }
+    return v;
+  }();
+  return out;
+}
+
+template <int N>
+void BM_PsdCheck(benchmark::State& state) {
+  const auto& P = filter_covariances<N>();
+  std::size_t k = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(posefuse::is_positive_semidefinite(P[k]));
+    k = (k + 1) & 255;
+  }
+}
+BENCHMARK_TEMPLATE(BM_PsdCheck, 2)->Name("BM_PsdCheck/2");
+BENCHMARK_TEMPLATE(BM_PsdCheck, 4)->Name("BM_PsdCheck/4");
+
+template <int N>
+void BM_PsdCheck_Reference(benchmark::State& state) {
+  const auto& P = filter_covariances<N>();
+  std::size_t k = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(posefuse::detail::psd_reference(P[k], false));
+    k = (k + 1) & 255;
+  }
+}
+BENCHMARK_TEMPLATE(BM_PsdCheck_Reference, 2)->Name("BM_PsdCheck_Reference/2");
+BENCHMARK_TEMPLATE(BM_PsdCheck_Reference, 4)->Name("BM_PsdCheck_Reference/4");
 
 }  // namespace

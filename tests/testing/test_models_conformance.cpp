@@ -62,6 +62,30 @@ struct FlipMotion {
   }
 };
 
+/// A motion model with linearize() (posefuse::HasLinearize) whose
+/// linearize().jacobian entry (i, j) alone has its sign flipped: jacobian()
+/// stays right, so only the check of the one-call form can notice.
+template <class M>
+struct FlipLinearize {
+  using State = typename M::State;
+  using Control = typename M::Control;
+  using T = posefuse::ScalarOf<State>;
+  M m;
+  int i, j;
+  State predict(const State& x, const Control& u, T dt) const { return m.predict(x, u, dt); }
+  posefuse::CovarianceOf<State> jacobian(const State& x, const Control& u, T dt) const {
+    return m.jacobian(x, u, dt);
+  }
+  posefuse::CovarianceOf<State> noise(const State& x, const Control& u, T dt) const {
+    return m.noise(x, u, dt);
+  }
+  auto linearize(const State& x, const Control& u, T dt) const {
+    auto lin = m.linearize(x, u, dt);
+    lin.jacobian(i, j) = -lin.jacobian(i, j);
+    return lin;
+  }
+};
+
 /// A measurement model whose Jacobian entry (i, j) has its sign flipped.
 template <class H>
 struct FlipMeasurement {
@@ -318,6 +342,22 @@ TEMPLATE_TEST_CASE("Models conformance: Se2Odometry, straight and turning increm
   cases.push_back({PlanarPose<T>{1, 2, T(std::numbers::pi - 1e-3)}, D(T(0.5), 0, T(0.1)), T(0.1)});
   const M model;
   check_motion_cases(model, cases, tol<T>());
+  // Its one-call form (what Ekf::predict uses) is checked as well: flipping
+  // any non-zero entry of linearize().jacobian alone fails a case.
+  static_assert(posefuse::HasLinearize<M>);
+  static_assert(posefuse::HasLinearize<FlipLinearize<M>>);
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      bool nonzero = false, detected = false;
+      const FlipLinearize<M> bad{model, i, j};
+      for (const auto& c : cases) {
+        nonzero = nonzero || model.jacobian(c.x, c.u, c.dt)(i, j) != 0;
+        detected = detected || !pt::check_motion_model(bad, c.x, c.u, c.dt, tol<T>());
+      }
+      INFO("flipped linearize() entry (" << i << ", " << j << ")");
+      CHECK(detected == nonzero);
+    }
+  }
   // jacobian_increment: d(x (+) delta) / d(t_delta_x, t_delta_y, theta_delta), components additive.
   for (const auto& c : cases) {
     const Eigen::Matrix<T, 3, 1> v(c.u.x(), c.u.y(), c.u.angle());

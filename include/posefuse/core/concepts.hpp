@@ -141,6 +141,22 @@ concept MotionModel =
       { m.noise(x, u, dt) } -> ReturnsExactly<CovarianceOf<typename M::State>>;
     };
 
+/// A MotionModel that also offers `linearize(x, u, dt)`, returning a struct
+/// with members `state`, `jacobian` and `noise` equal to `predict(x, u, dt)`,
+/// `jacobian(x, u, dt)` and `noise(x, u, dt)`, computed in one call that
+/// shares their work (e.g. the sine and cosine of a heading). Optional:
+/// Ekf::predict uses it when present and the three calls otherwise;
+/// testing::check_motion_model checks that the two agree and checks the
+/// returned Jacobian against central differences.
+template <class M>
+concept HasLinearize =
+    MotionModel<M> && requires(const M& m, const typename M::State& x,
+                               const typename M::Control& u, ScalarOf<typename M::State> dt) {
+      { m.linearize(x, u, dt).state } -> ReturnsExactly<typename M::State>;
+      { m.linearize(x, u, dt).jacobian } -> ReturnsExactly<CovarianceOf<typename M::State>>;
+      { m.linearize(x, u, dt).noise } -> ReturnsExactly<CovarianceOf<typename M::State>>;
+    };
+
 /// Jacobian of a measurement model, \f$ J_{h,x} \f$.
 template <class H>
 using MeasurementJacobianOf = Eigen::Matrix<ScalarOf<typename H::State>,

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <type_traits>
 
 namespace posefuse {
 
@@ -98,6 +99,139 @@ template <class M>
 }
 }  // namespace detail
 
+namespace detail {
+/// Bound on \f$ \|L^{-1}\|_F^2 \f$ for an n x n unit lower-triangular L
+/// whose entries are at most `l` in magnitude: \f$ |(L^{-1})_{ij}| \le
+/// l (1 + l)^{i-j-1} \f$, so \f$ n + \sum_{m=1}^{n-1} (n - m)\,
+/// (l (1 + l)^{m-1})^2 \f$.
+template <class T>
+[[nodiscard]] constexpr T unit_lower_inverse_bound(int n, T l) noexcept {
+  T sum = T(n), b = l;
+  for (int m = 1; m < n; ++m) {
+    sum += T(n - m) * b * b;
+    b *= T(1) + l;
+  }
+  return sum;
+}
+
+/// Largest size the fast path of is_positive_semidefinite handles.
+inline constexpr int kPsdFastMaxSize = 6;
+/// Largest multiplier of the scale-free factor the fast path accepts.
+inline constexpr int kPsdFastMaxMultiplier = 2;
+
+/// Smallest scale-free pivot the fast path accepts, for size n:
+/// \f$ \beta_n = 16\,K_n\,n(n+1)\,\epsilon \f$ with \f$ K_n \f$ =
+/// unit_lower_inverse_bound(n, 2) (double: 1.3e-13 at n = 2, 5.0e-9 at
+/// n = 6; float: 1.1e-3 at n = 3, 0.21 at n = 5; at n = 6 it exceeds 1, so
+/// float 6x6 always takes the reference path).
+template <class T>
+[[nodiscard]] constexpr T psd_fast_min_pivot(int n) noexcept {
+  return T(16) * unit_lower_inverse_bound<T>(n, T(kPsdFastMaxMultiplier)) * T(n) * T(n + 1) *
+         std::numeric_limits<T>::epsilon();
+}
+
+/// A sufficient condition for the criterion of is_positive_definite (and so
+/// of is_positive_semidefinite), cheaper than the reference: true only when
+/// the reference test (psd_reference) is certain to accept `m` as positive
+/// definite; false means "undecided", never "indefinite".
+///
+/// For fixed sizes 1..6: `m` exactly symmetric, every diagonal entry in
+/// [sqrt(min) / eps, sqrt(max) * eps] (no overflow or underflow below), then
+/// an LDLT of `m` in its given order, without pivoting, square roots or any
+/// division but one per pivot, in which every pivot of the scale-free form,
+/// \f$ d_k / m_{kk} \f$, is at least \f$ \beta_n \f$
+/// (psd_fast_min_pivot) and every multiplier of the scale-free factor,
+/// \f$ l_{ik} \sqrt{m_{kk} / m_{ii}} \f$, is at most 2 in magnitude.
+/// (Every entry of `m` enters a pivot or a multiplier, so a NaN or Inf
+/// fails one of these comparisons.)
+///
+/// Why that implies the reference accepts (C the scale-free form): with
+/// positive computed pivots, \f$ \hat L \hat D \hat L^\top = C + E \f$
+/// with \f$ \|E\|_2 \lesssim n \gamma_{n+1} \approx n(n+1)\epsilon \f$
+/// (Higham, *Accuracy and Stability*, Thm 10.3 and its proof: \f$ |\hat
+/// L||\hat D||\hat L^\top| \f$ has diagonal \f$ \approx 1 \f$); and
+/// \f$ \lambda_{\min}(C + E) \ge \min_k \hat d_k / \|\hat L^{-1}\|_2^2
+/// \ge \beta_n / K_n = 16 n(n+1)\epsilon \f$. So \f$ \lambda_{\min}(C)
+/// \gtrsim 15 n(n+1)\epsilon \f$; the reference's completely pivoted LDLT
+/// is then (by the same backward-error argument, and Demmel's condition
+/// for Cholesky to complete) exact for a matrix within \f$ \approx
+/// (n(n+1) + 3n)\epsilon \f$ of C, whose pivots are all at least its
+/// smallest eigenvalue \f$ \gtrsim (14 n(n+1) - 3n)\epsilon > 16 n
+/// \epsilon \f$, the tolerance: the reference accepts, as definite. tests/core/test_gaussian.cpp checks the agreement on
+/// random PSD, indefinite and near-singular matrices of sizes 1..6.
+template <class Derived>
+[[nodiscard]] bool psd_fast_accepts(const Eigen::MatrixBase<Derived>& m) {
+  using T = typename Derived::Scalar;
+  constexpr int N = Derived::RowsAtCompileTime;
+  if constexpr (N == Eigen::Dynamic || N != Derived::ColsAtCompileTime || N < 1 ||
+                N > kPsdFastMaxSize || !std::is_floating_point_v<T>) {
+    return false;
+  } else {
+    constexpr T beta = psd_fast_min_pivot<T>(N);
+    if constexpr (!(beta < T(1))) {
+      return false;
+    } else {
+      const T min_diag = std::sqrt(std::numeric_limits<T>::min()) / std::numeric_limits<T>::epsilon();
+      const T max_diag = std::sqrt(std::numeric_limits<T>::max()) * std::numeric_limits<T>::epsilon();
+      if constexpr (N == 1) {
+        return m(0, 0) >= min_diag && m(0, 0) <= max_diag;
+      } else if constexpr (N == 2) {
+        // The loop below in closed form, without a division: the scale-free
+        // pivot 1 - rho^2 >= beta, i.e. m10^2 <= (1 - beta) m00 m11 (which
+        // also bounds the multiplier |rho| by 1). A NaN or Inf fails.
+        if (!(m(0, 0) >= min_diag && m(0, 0) <= max_diag && m(1, 1) >= min_diag &&
+              m(1, 1) <= max_diag && m(1, 0) == m(0, 1)))
+          return false;
+        return m(1, 0) * m(1, 0) <= (T(1) - beta) * (m(0, 0) * m(1, 1));
+      }
+      constexpr T l2 = T(kPsdFastMaxMultiplier) * T(kPsdFastMaxMultiplier);
+      T diag[N];
+      T s[N][N];  // lower triangle of the Schur complements
+      for (int i = 0; i < N; ++i) {
+        diag[i] = m(i, i);
+        if (!(diag[i] >= min_diag && diag[i] <= max_diag)) return false;
+        s[i][i] = diag[i];
+        for (int j = 0; j < i; ++j) {
+          if (!(m(i, j) == m(j, i))) return false;
+          s[i][j] = m(i, j);
+        }
+      }
+      for (int k = 0; k < N; ++k) {
+        const T d = s[k][k];
+        if (!(d >= beta * diag[k])) return false;
+        const T inv = T(1) / d;
+        T l[N];
+        for (int i = k + 1; i < N; ++i) {
+          l[i] = s[i][k] * inv;
+          if (!(l[i] * l[i] * diag[k] <= l2 * diag[i])) return false;
+        }
+        for (int i = k + 1; i < N; ++i)
+          for (int j = k + 1; j <= i; ++j) s[i][j] -= l[i] * s[j][k];
+      }
+      return true;
+    }
+  }
+}
+}  // namespace detail
+
+namespace detail {
+/// The reference test behind is_positive_semidefinite (definite = false) and
+/// is_positive_definite (definite = true): finiteness, symmetry, the
+/// diagonal, then the completely pivoted LDLT of the scale-free form.
+template <class Derived>
+[[nodiscard]] bool psd_reference(const Eigen::MatrixBase<Derived>& m, bool definite) {
+  using T = typename Derived::Scalar;
+  using M = Eigen::Matrix<T, Derived::RowsAtCompileTime, Derived::ColsAtCompileTime>;
+  if (!m.allFinite() || !is_symmetric(m)) return false;
+  if (definite && !(m.diagonal().array() > T(0)).all()) return false;
+  M c;
+  if (!correlation_form(M(m), c)) return false;
+  const T tol = definiteness_tolerance<T>(int(c.rows()));
+  const T p = smallest_pivot(c, tol);
+  return definite ? p > tol : p >= -tol;
+}
+}  // namespace detail
+
 /// True when a symmetric matrix is positive semi-definite.
 ///
 /// **The criterion, used everywhere in posefuse** (covariance validation,
@@ -111,13 +245,7 @@ template <class M>
 /// (unlike a tolerance relative to max|m_ij|).
 template <class Derived>
 [[nodiscard]] bool is_positive_semidefinite(const Eigen::MatrixBase<Derived>& m) {
-  using T = typename Derived::Scalar;
-  using M = Eigen::Matrix<T, Derived::RowsAtCompileTime, Derived::ColsAtCompileTime>;
-  if (!m.allFinite() || !is_symmetric(m)) return false;
-  M c;
-  if (!detail::correlation_form(M(m), c)) return false;
-  const T tol = detail::definiteness_tolerance<T>(int(c.rows()));
-  return detail::smallest_pivot(c, tol) >= -tol;
+  return detail::psd_fast_accepts(m) || detail::psd_reference(m, false);
 }
 
 /// True when a symmetric matrix is positive definite: every diagonal entry
@@ -127,14 +255,7 @@ template <class Derived>
 /// Cholesky factorisation succeed.
 template <class Derived>
 [[nodiscard]] bool is_positive_definite(const Eigen::MatrixBase<Derived>& m) {
-  using T = typename Derived::Scalar;
-  using M = Eigen::Matrix<T, Derived::RowsAtCompileTime, Derived::ColsAtCompileTime>;
-  if (!m.allFinite() || !is_symmetric(m)) return false;
-  if (!(m.diagonal().array() > T(0)).all()) return false;
-  M c;
-  if (!detail::correlation_form(M(m), c)) return false;
-  const T tol = detail::definiteness_tolerance<T>(int(c.rows()));
-  return detail::smallest_pivot(c, tol) > tol;
+  return detail::psd_fast_accepts(m) || detail::psd_reference(m, true);
 }
 
 /// Throws posefuse::invalid_argument unless `m` is a finite, symmetric,

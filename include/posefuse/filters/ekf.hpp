@@ -257,15 +257,27 @@ class Ekf {
     if (!initialised_) return FilterStatus::kNotInitialised;
     if (!std::isfinite(dt)) return FilterStatus::kNonFinite;
     if (dt < Scalar(0)) return FilterStatus::kInvalidInput;
-    const StateType x_new = motion_.predict(x_, u, dt);
+    StateType x_new = detail::zero_state<StateType>();
     Covariance P_new;
     if constexpr (has_identity_jacobian_v<Motion>) {
+      x_new = motion_.predict(x_, u, dt);
       P_new = P_ + Covariance(motion_.noise(x_, u, dt));
       if (!minus(x_new, x_).allFinite() || !P_new.allFinite()) return FilterStatus::kNonFinite;
       P_new = symmetrised(P_new);
       if (!is_positive_semidefinite(P_new)) return FilterStatus::kNotPositiveDefinite;
       // F_ stays the identity it was initialised to.
+    } else if constexpr (HasLinearize<Motion>) {
+      // One model call (see HasLinearize, core/concepts.hpp); the same values as below.
+      const auto lin = motion_.linearize(x_, u, dt);
+      x_new = lin.state;
+      const Covariance F = lin.jacobian;
+      P_new = F * P_ * F.transpose() + Covariance(lin.noise);
+      if (!minus(x_new, x_).allFinite() || !P_new.allFinite()) return FilterStatus::kNonFinite;
+      P_new = symmetrised(P_new);
+      if (!is_positive_semidefinite(P_new)) return FilterStatus::kNotPositiveDefinite;
+      F_ = F;  // recorded for the smoother only when the step is applied
     } else {
+      x_new = motion_.predict(x_, u, dt);
       const Covariance F = motion_.jacobian(x_, u, dt);
       P_new = F * P_ * F.transpose() + Covariance(motion_.noise(x_, u, dt));
       if (!minus(x_new, x_).allFinite() || !P_new.allFinite()) return FilterStatus::kNonFinite;

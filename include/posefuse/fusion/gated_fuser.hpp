@@ -298,6 +298,7 @@ class GatedFuser {
   void reset(const Pose& start, const Mat3& cov) {
     ekf_.reset(start, cov);
     a_ = Pose{};
+    a_g_ = as_se2(a_);
     Pa_.setZero();
     have_odom_ = false;
     anchor_ = AnchorState::kNone;
@@ -316,13 +317,16 @@ class GatedFuser {
       return FilterStatus::kNonFinite;
     if (!have_odom_) {
       odom_ = odom;
+      odom_g_ = as_se2(odom);
       have_odom_ = true;
       return FilterStatus::kApplied;
     }
-    const SE2<T> d = as_se2(odom_).between(as_se2(odom));  // δ = O_{k-1}^-1 O_k
+    const SE2<T> g = as_se2(odom);
+    const SE2<T> d = odom_g_.between(g);  // δ = O_{k-1}^-1 O_k
     const FilterStatus s = ekf_.predict(d, T(0));
     if (s != FilterStatus::kApplied) return s;
     odom_ = odom;
+    odom_g_ = g;
     travelled_ += std::hypot(d.x(), d.y());
     return s;
   }
@@ -339,7 +343,7 @@ class GatedFuser {
       return FuserStatus::kNonFinite;
     if (new_map_frame || anchor_ == AnchorState::kNone) start_anchoring();
     if (anchor_ == AnchorState::kCollecting) return collect(z);
-    const Pose zw = as_planar_pose(as_se2(a_) * as_se2(z));  // SLAM pose in the world
+    const Pose zw = as_planar_pose(a_g_ * as_se2(z));  // SLAM pose in the world
     FuserGate failed = FuserGate::kNone;
     const auto gates = [this, &failed](const Vec3& r, const Mat3& S, T nis) {
       failed = which_gate_fails(r, S, nis);
@@ -395,7 +399,7 @@ class GatedFuser {
   /// estimate (rebasing); `as_se2(odometry_correction()) * as_se2(odom)` is
   /// the fused pose at the last predict().
   [[nodiscard]] Pose odometry_correction() const noexcept {
-    return as_planar_pose(as_se2(pose()) * as_se2(odom_).inverse());
+    return as_planar_pose(as_se2(pose()) * odom_g_.inverse());
   }
   /// Odometry distance travelled since construction or reset() (m).
   [[nodiscard]] T travelled() const noexcept { return travelled_; }
@@ -489,6 +493,7 @@ class GatedFuser {
         return FuserStatus::kAnchoring;  // inconsistent (frozen, jumping): keep collecting
     }
     a_ = mean;
+    a_g_ = T_wm;
     Pa_ = covariance();
     anchor_ = AnchorState::kAnchored;
     ++anchors_;
@@ -499,6 +504,9 @@ class GatedFuser {
   Filter ekf_;
   PlanarPoseFix<T> slam_;
   Pose a_{}, odom_{};
+  // as_se2(a_) and as_se2(odom_), kept with them (their sine and cosine
+  // computed once per change, not once per use).
+  SE2<T> a_g_{}, odom_g_{};
   Mat3 Pa_ = Mat3::Zero();
   bool have_odom_ = false;
   AnchorState anchor_ = AnchorState::kNone;
@@ -506,8 +514,5 @@ class GatedFuser {
   T travelled_ = 0;
   int n_cand_ = 0, rejects_ = 0, anchors_ = 0;
 };
-
-static_assert(Stage<GatedFuser<double>>);
-static_assert(Stage<GatedFuser<float>>);
 
 }  // namespace posefuse

@@ -121,14 +121,34 @@ class Se2Odometry {
     return Jd * increment_variance(d).asDiagonal() * Jd.transpose();
   }
 
+  /// predict(), jacobian() and noise() at once (Ekf uses it, see
+  /// HasLinearize): the same values bit for bit, with the sine and
+  /// cosine of x.theta computed once instead of three times.
+  struct Linearization {
+    State state;       ///< \f$ x \oplus \delta \f$
+    Matrix3 jacobian;  ///< F
+    Matrix3 noise;     ///< Q
+  };
+  [[nodiscard]] Linearization linearize(const State& x, const Control& d, T /*dt_s*/) const noexcept {
+    const SE2<T> g = as_se2(x);
+    Linearization out;
+    out.state = as_planar_pose(g.compose(d));
+    typename SE2<T>::ActJacobianGroup J_t_x;
+    typename SE2<T>::ActJacobianPoint J_t_d;
+    (void)g.act(d.translation(), &J_t_x, &J_t_d);
+    out.jacobian = Matrix3::Identity();
+    out.jacobian.template topRightCorner<2, 1>() = J_t_x.col(2);
+    Matrix3 Jd = Matrix3::Identity();
+    Jd.template topLeftCorner<2, 2>() = J_t_d;
+    out.noise = Jd * increment_variance(d).asDiagonal() * Jd.transpose();
+    return out;
+  }
+
   /// The noise rates.
   [[nodiscard]] const Se2OdometryNoise<T>& noise_rates() const noexcept { return n_; }
 
  private:
   Se2OdometryNoise<T> n_;
 };
-
-static_assert(MotionModel<Se2Odometry<double>>);
-static_assert(MotionModel<Se2Odometry<float>>);
 
 }  // namespace posefuse

@@ -327,6 +327,22 @@ template <MotionModel M>
       step));
   const CovarianceOf<S> Q = model.noise(x, u, dt_s);
   r.push_back(check_covariance("noise (Q)", Q, tol));
+  if constexpr (HasLinearize<M>) {
+    // The one-call form must agree with the three calls, and its Jacobian
+    // is checked on its own: a wrong entry there alone must fail.
+    const auto lin = model.linearize(x, u, dt_s);
+    r.push_back(detail::value_check("linearize().state == predict()",
+                                    double(posefuse::minus(lin.state, y).cwiseAbs().maxCoeff()),
+                                    tol));
+    r.push_back(detail::value_check("linearize().jacobian == jacobian()",
+                                    double((lin.jacobian - F).cwiseAbs().maxCoeff()), tol));
+    r.push_back(detail::value_check("linearize().noise == noise()",
+                                    double((lin.noise - Q).cwiseAbs().maxCoeff()), tol));
+    r.push_back(check_jacobian(
+        "linearize().jacobian (J_f_x)",
+        [&](const S& s) -> S { return model.predict(s, u, dt_s); }, x,
+        CovarianceOf<S>(lin.jacobian), tol, step));
+  }
   return combine("check_motion_model", r);
 }
 
