@@ -71,10 +71,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <numbers>
-#include <ranges>
 #include <string>
 #include <utility>
 #include <vector>
@@ -214,9 +214,11 @@ struct MagnetometerSetup {
     m.note = "not calibrated (disabled)";
     return m;
   }
-  const auto horizontal = log.imu | std::views::transform([](const ImuSample& s) {
-                            return Eigen::Vector2d(s.mag_uT.x(), s.mag_uT.y());
-                          });
+  // A vector, not `log.imu | std::views::transform(...)`: clang 14 cannot
+  // compile libstdc++ 12's views (any std::ranges::view_interface).
+  std::vector<Eigen::Vector2d> horizontal;
+  horizontal.reserve(log.imu.size());
+  for (const ImuSample& s : log.imu) horizontal.emplace_back(s.mag_uT.x(), s.mag_uT.y());
   const HorizontalEllipseFitOptions options;
   const HorizontalEllipseFit fit = fit_horizontal_ellipse(horizontal, options);
   m.calibrated = fit.ok();
@@ -555,7 +557,12 @@ inline void evaluate_methods(CorridorRunResult& res, const CorridorRunConfig& cf
   SlamOnlyMethod slam_only;
   SeedFuserMethod seed(log.params.fuser_threshold, cfg.slam_stale_s);
   GatedFuserMethod gated(cfg);
-  auto& [slam_track, odom_track, seed_track, gated_track] = res.tracks;
+  // Plain references, not a structured binding: the lambdas below capture them,
+  // which clang <= 15 rejects for structured bindings.
+  PlanarTrajectory& slam_track = res.tracks[static_cast<std::size_t>(CorridorMethod::kSlamOnly)];
+  PlanarTrajectory& odom_track = res.tracks[static_cast<std::size_t>(CorridorMethod::kOdometryOnly)];
+  PlanarTrajectory& seed_track = res.tracks[static_cast<std::size_t>(CorridorMethod::kSeedFuser)];
+  PlanarTrajectory& gated_track = res.tracks[static_cast<std::size_t>(CorridorMethod::kGatedFuser)];
   std::vector<const SlamSample*> pending;  // SLAM held until odometry reaches its time
 
   const auto process_slam = [&](const SlamSample& r, const OdometryAt& o) {

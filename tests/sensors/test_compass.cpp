@@ -4,6 +4,8 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstddef>
+#include <iterator>
 #include <numbers>
 #include <posefuse/core/angles.hpp>
 #include <posefuse/core/error.hpp>
@@ -29,6 +31,46 @@ Eigen::Matrix<T, 3, 1> reading(T roll, T pitch, T yaw) {
   return posefuse::rotation_from_euler_zyx(posefuse::EulerZYX<T>{roll, pitch, yaw}).transpose() *
          field_world<T>();
 }
+
+/// A lazy forward range applying `f` to each element of a vector, returning
+/// by value: what `v | std::views::transform(f)` is, written out because
+/// clang 14 cannot compile libstdc++ 12's views (std::ranges::view_interface).
+template <class Src, class Out>
+class MappedRange {
+ public:
+  using Fn = Out (*)(const Src&);
+  class iterator {
+   public:
+    using iterator_concept = std::forward_iterator_tag;
+    using iterator_category = std::forward_iterator_tag;
+    using value_type = Out;
+    using difference_type = std::ptrdiff_t;
+    iterator() = default;
+    iterator(const Src* p, Fn f) : p_(p), f_(f) {}
+    Out operator*() const { return f_(*p_); }
+    iterator& operator++() {
+      ++p_;
+      return *this;
+    }
+    iterator operator++(int) {
+      iterator old = *this;
+      ++p_;
+      return old;
+    }
+    bool operator==(const iterator& o) const { return p_ == o.p_; }
+
+   private:
+    const Src* p_ = nullptr;
+    Fn f_ = nullptr;
+  };
+  MappedRange(const std::vector<Src>& v, Fn f) : v_(&v), f_(f) {}
+  iterator begin() const { return {v_->data(), f_}; }
+  iterator end() const { return {v_->data() + v_->size(), f_}; }
+
+ private:
+  const std::vector<Src>* v_;
+  Fn f_;
+};
 }  // namespace
 
 TEMPLATE_TEST_CASE("Compass: heading hand-worked at zero tilt", "[sensors][compass]", float, double) {
@@ -235,9 +277,10 @@ TEST_CASE("Compass: horizontal ellipse fit takes any range of 2-vectors, e.g. a 
   const auto raw = turning_readings(Eigen::Matrix2d::Identity(), Eigen::Vector2d(3, 4), 2 * std::numbers::pi, 100);
   std::vector<posefuse::ImuSample> imu(raw.size());
   for (std::size_t i = 0; i < raw.size(); ++i) imu[i].mag_uT << raw[i], -40.0;
-  const auto view = imu | std::views::transform([](const posefuse::ImuSample& s) {
-                      return Eigen::Vector2d(s.mag_uT.head<2>());
-                    });
+  const MappedRange<posefuse::ImuSample, Eigen::Vector2d> view(imu, [](const posefuse::ImuSample& s) {
+    return Eigen::Vector2d(s.mag_uT.head<2>());
+  });
+  static_assert(std::ranges::forward_range<decltype(view)>);
   const auto a = posefuse::fit_horizontal_ellipse(view);
   const auto b = posefuse::fit_horizontal_ellipse(raw);
   REQUIRE(a.ok());
@@ -298,7 +341,8 @@ TEST_CASE("Compass: ellipsoid fit takes a std::span and a view as well as a vect
   }
   const auto a = posefuse::fit_ellipsoid(raw);
   const auto b = posefuse::fit_ellipsoid(std::span<const Eigen::Vector3d>(raw));
-  const auto c = posefuse::fit_ellipsoid(raw | std::views::transform([](const Eigen::Vector3d& v) { return v; }));
+  const auto c = posefuse::fit_ellipsoid(MappedRange<Eigen::Vector3d, Eigen::Vector3d>(
+      raw, [](const Eigen::Vector3d& v) -> Eigen::Vector3d { return v; }));
   CHECK(a.hard_iron == b.hard_iron);
   CHECK(a.soft_iron == c.soft_iron);
   CHECK((a.hard_iron - Eigen::Vector3d(4, -2, 7)).norm() < 1e-6);

@@ -374,8 +374,12 @@ inline std::array<double, 4> quat_from_zyx(double yaw, double pitch, double roll
       reinit_done = true;
     }
     r.position_m = Eigen::Vector3d(x, y, z);
-    const std::array<double, 4> q = detail::quat_from_zyx(wrap_angle(yaw), rng.normal(cfg.slam_sigma_yaw),
-                                                          rng.normal(cfg.slam_sigma_yaw));
+    // One draw per statement (the order of function arguments is unspecified:
+    // g++ and clang drew these two in opposite orders); roll first, as the
+    // published tables were made.
+    const double roll_noise = rng.normal(cfg.slam_sigma_yaw);
+    const double pitch_noise = rng.normal(cfg.slam_sigma_yaw);
+    const std::array<double, 4> q = detail::quat_from_zyx(wrap_angle(yaw), pitch_noise, roll_noise);
     r.orientation.coeffs() << q[0], q[1], q[2], q[3];  // x, y, z, w
     log.slam.push_back(r);
   }
