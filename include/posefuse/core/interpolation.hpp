@@ -152,7 +152,7 @@ void require_time_order(const Trajectory& traj, const char* what) {
 ///         (PlanarTrajectory::validate_time_order)
 template <class Lazy = void>
 [[nodiscard]] std::optional<Eigen::Vector3d> interpolate_at(const PlanarTrajectory& traj,
-                                                                 double t_s) {
+                                                          double t_s) {
   if (!std::isfinite(t_s)) throw invalid_argument("interpolate_at: the time is not finite");
   traj.validate_time_order();
   return detail::interpolate_in_order(traj, t_s);
@@ -170,7 +170,7 @@ template <class Lazy = void>
 ///         mismatched counts, a non-finite entry or decreasing stamps
 template <class Lazy = void>
 [[nodiscard]] std::optional<Eigen::Isometry3d> interpolate_at(const Trajectory& traj,
-                                                                   double t_s) {
+                                                            double t_s) {
   if (!std::isfinite(t_s)) throw invalid_argument("interpolate_at: the time is not finite");
   detail::require_time_order(traj, "interpolate_at");
   if (traj.empty() || t_s < traj.t_s.front() || t_s > traj.t_s.back()) return std::nullopt;

@@ -120,7 +120,7 @@ template <class Lazy = void>
 /// @return one 2-D point per pose (m)
 template <class Lazy = void>
 [[nodiscard]] std::vector<Eigen::Vector2d> project_to_plane(const Trajectory& traj,
-                                                                   Plane plane) {
+                                                            Plane plane) {
   std::vector<Eigen::Vector2d> out;
   out.reserve(traj.poses.size());
   for (const Eigen::Isometry3d& T : traj.poses) out.push_back(project_to_plane(T, plane));

@@ -81,8 +81,8 @@ struct AlignmentResult {
 // compiled by every file that includes this header (compile cost, README).
 template <class Lazy = void>
 [[nodiscard]] AlignmentResult umeyama_alignment(std::span<const Eigen::Vector3d> x,
-                                                       std::span<const Eigen::Vector3d> y,
-                                                       bool with_scale) {
+                                                std::span<const Eigen::Vector3d> y,
+                                                bool with_scale) {
   if (x.size() != y.size()) {
     throw invalid_argument("umeyama_alignment: " + std::to_string(x.size()) + " source but " +
                            std::to_string(y.size()) + " target points");
@@ -168,8 +168,8 @@ struct AlignedTrajectory {
 ///         degenerate cases of `umeyama_alignment`
 template <class Lazy = void>
 [[nodiscard]] AlignedTrajectory align_trajectory(const Trajectory& est,
-                                                        const Trajectory& ref,
-                                                        Alignment alignment) {
+                                                 const Trajectory& ref,
+                                                 Alignment alignment) {
   if (est.size() != ref.size()) {
     throw invalid_argument("align_trajectory: estimate has " + std::to_string(est.size()) +
                            " poses but reference has " + std::to_string(ref.size()) +

@@ -33,7 +33,7 @@ namespace posefuse {
 /// @throws posefuse::invalid_argument for different or zero lengths
 template <class Lazy = void>
 [[nodiscard]] double rmse_2d(std::span<const Eigen::Vector2d> gt_xy,
-                                    std::span<const Eigen::Vector2d> est_xy) {
+                             std::span<const Eigen::Vector2d> est_xy) {
   if (gt_xy.size() != est_xy.size()) {
     throw invalid_argument("rmse_2d: " + std::to_string(gt_xy.size()) + " ground-truth but " +
                            std::to_string(est_xy.size()) + " estimated points");
@@ -126,8 +126,8 @@ struct MetricResult {
 ///         degenerate alignment
 template <class Lazy = void>
 [[nodiscard]] MetricResult ape(const Trajectory& ref, const Trajectory& est,
-                                      PoseRelation relation = PoseRelation::kTranslation,
-                                      Alignment alignment = Alignment::kNone) {
+                               PoseRelation relation = PoseRelation::kTranslation,
+                               Alignment alignment = Alignment::kNone) {
   if (ref.size() != est.size() || ref.empty()) {
     throw invalid_argument("ape: reference has " + std::to_string(ref.size()) +
                            " poses and estimate " + std::to_string(est.size()) +
@@ -241,7 +241,7 @@ struct RpeOptions {
 ///         in frames of at least the number of poses, however large)
 template <class Lazy = void>
 [[nodiscard]] MetricResult rpe(const Trajectory& ref, const Trajectory& est,
-                                      const RpeOptions& options = {}) {
+                               const RpeOptions& options = {}) {
   if (ref.size() != est.size() || ref.empty()) {
     throw invalid_argument("rpe: reference has " + std::to_string(ref.size()) +
                            " poses and estimate " + std::to_string(est.size()) +

@@ -51,7 +51,7 @@ struct PlanarErrors {
 ///         PlanarTrajectory::validate_time_order)
 template <class Lazy = void>
 [[nodiscard]] PlanarErrors planar_errors(const PlanarTrajectory& track,
-                                                const PlanarTrajectory& reference) {
+                                         const PlanarTrajectory& reference) {
   track.validate_time_order();
   reference.validate_time_order();
   PlanarErrors out;
@@ -81,7 +81,7 @@ template <class Lazy = void>
 ///         position, or `start`, is not finite
 template <class Lazy = void>
 [[nodiscard]] double loop_closure_error(const PlanarTrajectory& track,
-                                               const Eigen::Vector2d& start) {
+                                        const Eigen::Vector2d& start) {
   if (track.empty()) throw invalid_argument("loop_closure_error: the track has no pose");
   const Eigen::Vector3d& p = track.poses.back();
   if (!p.allFinite() || !start.allFinite())
@@ -103,7 +103,7 @@ template <class Lazy = void>
 ///         PlanarTrajectory::validate_time_order)
 template <class Lazy = void>
 [[nodiscard]] double time_without_pose(const PlanarTrajectory& track, double t_begin_s,
-                                              double t_end_s, double max_gap_s) {
+                                       double t_end_s, double max_gap_s) {
   if (!std::isfinite(t_begin_s) || !std::isfinite(t_end_s) || !(t_end_s >= t_begin_s))
     throw invalid_argument("time_without_pose: need finite t_begin_s <= t_end_s");
   if (!std::isfinite(max_gap_s) || !(max_gap_s >= 0))

@@ -49,8 +49,8 @@ namespace detail::traj_io {
 /// numpy's linear scan; ties resolve to the first index as np.argmin does.
 template <class Lazy = void>
 void match_nearest(std::span<const double> short_stamps, std::span<const double> long_stamps,
-                          double max_diff, double offset, std::vector<std::size_t>& short_ids,
-                          std::vector<std::size_t>& long_ids) {
+                   double max_diff, double offset, std::vector<std::size_t>& short_ids,
+                   std::vector<std::size_t>& long_ids) {
   std::vector<double> shifted(long_stamps.begin(), long_stamps.end());
   for (double& t : shifted) t += offset;  // rounding keeps the order (may create equal values)
   for (std::size_t i = 0; i < short_stamps.size(); ++i) {
@@ -104,8 +104,8 @@ void check_stamps(std::span<const double> stamps, const char* which) {
 ///         no pair matches
 template <class Lazy = void>
 [[nodiscard]] Association associate(std::span<const double> ref_stamps,
-                                           std::span<const double> est_stamps,
-                                           double max_diff_s = 0.01, double offset_est_s = 0.0) {
+                                    std::span<const double> est_stamps,
+                                    double max_diff_s = 0.01, double offset_est_s = 0.0) {
   if (!(max_diff_s >= 0.0) || !std::isfinite(max_diff_s)) {
     throw invalid_argument("associate: max time difference must be finite and >= 0, got " +
                            detail::traj_io::format_number(max_diff_s));
@@ -146,8 +146,8 @@ template <class Lazy = void>
 ///         `validate()`, for bad parameters, or when nothing matches
 template <class Lazy = void>
 [[nodiscard]] AssociatedTrajectories associate(const Trajectory& ref, const Trajectory& est,
-                                                      double max_diff_s = 0.01,
-                                                      double offset_est_s = 0.0) {
+                                               double max_diff_s = 0.01,
+                                               double offset_est_s = 0.0) {
   ref.validate();
   est.validate();
   const Association a = associate(ref.t_s, est.t_s, max_diff_s, offset_est_s);

@@ -62,7 +62,7 @@ template <class Lazy = void>
 /// @throws posefuse::io_error when the file cannot be written
 template <class Lazy = void>
 void write_trajectory(const std::filesystem::path& file, const Trajectory& traj,
-                             Format format) {
+                      Format format) {
   if (format == Format::kTum) {
     write_tum(file, traj);
   } else {

@@ -37,7 +37,7 @@ struct NumberedRows {
 
 template <class Lazy = void>
 NumberedRows<Eigen::Isometry3d> read_kitti_rows(const std::filesystem::path& file,
-                                                       const ReadOptions& options) {
+                                                const ReadOptions& options) {
   LineReader reader(file);
   NumberedRows<Eigen::Isometry3d> rows;
   std::string line;

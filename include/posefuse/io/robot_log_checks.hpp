@@ -106,9 +106,9 @@ template <class Lazy = void>
 /// @throws posefuse::io_error (file:line) naming wheel, ticks, time and speed
 template <class Lazy = void>
 void check_wheel_increments(const std::vector<WheelSample>& w, const RobotLogParams& p,
-                                   const std::filesystem::path& file,
-                                   std::span<const std::size_t> lines = {},
-                                   const RobotLogLimits& lim = {}) {
+                            const std::filesystem::path& file,
+                            std::span<const std::size_t> lines = {},
+                            const RobotLogLimits& lim = {}) {
   const double m_per_tick = 2 * std::numbers::pi * p.wheel_radius_m / p.ticks_per_rev;
   if (!(m_per_tick > 0) || !std::isfinite(m_per_tick)) return;  // robot.txt is checked elsewhere
   static constexpr const char* kNames[4] = {"fl", "fr", "bl", "br"};
@@ -139,7 +139,7 @@ void check_wheel_increments(const std::vector<WheelSample>& w, const RobotLogPar
 /// Throws unless the first rows of imu.csv read gravity as +z (REP-103).
 template <class Lazy = void>
 void check_imu_axes(const std::vector<ImuSample>& imu, const std::filesystem::path& file,
-                           const RobotLogLimits& lim = {}) {
+                    const RobotLogLimits& lim = {}) {
   const std::size_t n = std::min(imu.size(), lim.imu_rest_rows);
   if (n == 0) return;
   std::vector<double> ax, ay, az;
@@ -163,7 +163,7 @@ void check_imu_axes(const std::vector<ImuSample>& imu, const std::filesystem::pa
 /// @throws posefuse::io_error naming the file
 template <class Lazy = void>
 int check_slam_tilt(const std::vector<SlamSample>& slam, const std::filesystem::path& file,
-                           const RobotLogLimits& lim = {}) {
+                    const RobotLogLimits& lim = {}) {
   int valid = 0, tilted = 0;
   for (const SlamSample& r : slam) {
     if (r.state == SlamState::kLost) continue;
@@ -182,7 +182,7 @@ int check_slam_tilt(const std::vector<SlamSample>& slam, const std::filesystem::
 /// unit or epoch; see the file comment).
 template <class Lazy = void>
 void check_stream_clocks(const RobotLog& log, const std::filesystem::path& dir,
-                                const RobotLogLimits& lim = {}) {
+                         const RobotLogLimits& lim = {}) {
   if (log.wheels.size() < 2) return;
   const double wa = double(log.wheels.front().t_ns), wb = double(log.wheels.back().t_ns);
   const auto check = [&](const char* name, double a, double b) {
@@ -217,8 +217,8 @@ void check_stream_clocks(const RobotLog& log, const std::filesystem::path& dir,
 /// and back wheels of a side disagreeing, driving mostly backwards.
 template <class Lazy = void>
 [[nodiscard]] std::vector<std::string> wheel_path_warnings(const std::vector<WheelSample>& w,
-                                                                  const RobotLogParams& p,
-                                                                  const std::filesystem::path& file) {
+                                                           const RobotLogParams& p,
+                                                           const std::filesystem::path& file) {
   std::vector<std::string> out;
   if (w.size() < 2 || !(p.ticks_per_rev > 0) || !(p.track_width_m > 0)) return out;
   const double m = 2 * std::numbers::pi * p.wheel_radius_m / p.ticks_per_rev;
@@ -267,8 +267,8 @@ template <class Lazy = void>
 /// @throws posefuse::io_error for the errors of the file comment
 template <class Lazy = void>
 [[nodiscard]] std::vector<std::string> check_robot_log(const RobotLog& log,
-                                                              const std::filesystem::path& dir = {},
-                                                              const RobotLogLimits& lim = {}) {
+                                                       const std::filesystem::path& dir = {},
+                                                       const RobotLogLimits& lim = {}) {
   std::vector<std::string> warnings;
   check_stream_clocks(log, dir, lim);
   check_wheel_increments(log.wheels, log.params, detail::log_file(dir, "wheels.csv"), {}, lim);

@@ -39,7 +39,7 @@ namespace posefuse {
 ///         ("no poses")
 template <class Lazy = void>
 [[nodiscard]] Trajectory read_tum(const std::filesystem::path& file,
-                                         const ReadOptions& options = {}) {
+                                  const ReadOptions& options = {}) {
   detail::LineReader reader(file);
   Trajectory traj;
   std::size_t previous_line = 0;

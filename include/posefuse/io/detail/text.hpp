@@ -74,7 +74,7 @@ template <class Lazy = void>
 /// @throws posefuse::io_error naming file, line and 1-based column
 template <class Lazy = void>
 [[nodiscard]] double parse_number(std::string_view token, const std::filesystem::path& file,
-                                         std::size_t line, std::size_t column) {
+                                  std::size_t line, std::size_t column) {
   std::string_view digits = token;
   if (digits.size() > 1 && digits.front() == '+' && digits[1] != '-' && digits[1] != '+') {
     digits.remove_prefix(1);
@@ -105,9 +105,9 @@ template <class Lazy = void>
 /// @throws posefuse::io_error on a wrong column count or a bad number
 template <class Lazy = void>
 [[nodiscard]] std::vector<double> parse_row(std::string_view line, std::size_t expected,
-                                                   std::string_view what,
-                                                   const std::filesystem::path& file,
-                                                   std::size_t line_no) {
+                                            std::string_view what,
+                                            const std::filesystem::path& file,
+                                            std::size_t line_no) {
   const std::vector<std::string_view> tokens = split_whitespace(line);
   if (tokens.size() != expected) {
     throw io_error(file, line_no,
@@ -142,8 +142,8 @@ inline constexpr double kExactlyOrthonormal = 1e-12;
 // a reader is used, not in every file including an io/ header.
 template <class Lazy = void>
 [[nodiscard]] Eigen::Matrix3d checked_rotation(const Eigen::Matrix3d& R, double tolerance,
-                                                      const std::filesystem::path& file,
-                                                      std::size_t line) {
+                                               const std::filesystem::path& file,
+                                               std::size_t line) {
   const double residual = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   if (!(residual <= tolerance)) {
     throw io_error(file, line,
@@ -163,9 +163,9 @@ template <class Lazy = void>
 /// @throws posefuse::io_error for a zero or clearly non-unit quaternion
 template <class Lazy = void>
 [[nodiscard]] Eigen::Quaterniond checked_quaternion(const Eigen::Quaterniond& q,
-                                                           double tolerance,
-                                                           const std::filesystem::path& file,
-                                                           std::size_t line) {
+                                                    double tolerance,
+                                                    const std::filesystem::path& file,
+                                                    std::size_t line) {
   const double norm = q.norm();
   if (norm == 0.0) throw io_error(file, line, "quaternion has zero norm");
   if (!(std::abs(norm - 1.0) <= tolerance)) {
