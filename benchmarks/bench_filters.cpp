@@ -63,42 +63,12 @@ const Frames& frames() {
   return f;
 }
 
-void BM_Seed000Ekf_Step_posefuse(benchmark::State& state) {
-  const Frames& f = frames();
-  posefuse::Ekf<posefuse::PlanarDisplacement<double>, posefuse::PositionFix<2>> ekf(
-      posefuse::PlanarDisplacement<double>::from_sigmas(0.1, 0.1),
-      posefuse::PositionFix<2>::isotropic(0.5));
-  ekf.reset(f.z[0], Eigen::Matrix2d::Identity());
-  std::size_t k = 0;
-  for (auto _ : state) {
-    benchmark::DoNotOptimize(ekf.predict(f.u[k], 1.0));
-    auto r = ekf.update<0>(f.z[k]);
-    benchmark::DoNotOptimize(r);
-    k = (k + 1) & 1023;
-  }
-  benchmark::DoNotOptimize(ekf.state());
-}
-BENCHMARK(BM_Seed000Ekf_Step_posefuse)->Name("BM_Seed000Ekf_Step/posefuse");
-
-void BM_Seed000Ekf_Step_posefuse_plus_check(benchmark::State& state) {
-  const Frames& f = frames();
-  posefuse::Ekf<posefuse::PlanarDisplacement<double>, posefuse::PositionFix<2>> ekf(
-      posefuse::PlanarDisplacement<double>::from_sigmas(0.1, 0.1),
-      posefuse::PositionFix<2>::isotropic(0.5));
-  ekf.reset(f.z[0], Eigen::Matrix2d::Identity());
-  std::size_t k = 0;
-  for (auto _ : state) {
-    benchmark::DoNotOptimize(ekf.predict(f.u[k], 1.0));
-    benchmark::DoNotOptimize(posefuse::is_positive_semidefinite(ekf.covariance()));
-    auto r = ekf.update<0>(f.z[k]);
-    benchmark::DoNotOptimize(r);
-    k = (k + 1) & 1023;
-  }
-  benchmark::DoNotOptimize(ekf.state());
-}
-BENCHMARK(BM_Seed000Ekf_Step_posefuse_plus_check)->Name("BM_Seed000Ekf_Step/posefuse_plus_check");
-
-void BM_Seed000Ekf_Step_posefuse_recompute(benchmark::State& state) {
+// One posefuse seed-000 step; kRecompute: update_with() a sensor built once
+// outside the loop, so the gain memo of update<0> is never used; kExtraCheck:
+// one more is_positive_semidefinite of the predicted covariance per step
+// (the `_plus_check` rows: the cost of one check in context).
+template <bool kRecompute, bool kExtraCheck>
+void BM_Seed000Ekf_Step_posefuse_variant(benchmark::State& state) {
   const Frames& f = frames();
   const posefuse::PositionFix<2> fix = posefuse::PositionFix<2>::isotropic(0.5);
   posefuse::Ekf<posefuse::PlanarDisplacement<double>, posefuse::PositionFix<2>> ekf(
@@ -107,31 +77,26 @@ void BM_Seed000Ekf_Step_posefuse_recompute(benchmark::State& state) {
   std::size_t k = 0;
   for (auto _ : state) {
     benchmark::DoNotOptimize(ekf.predict(f.u[k], 1.0));
-    auto r = ekf.update_with(fix, f.z[k]);
-    benchmark::DoNotOptimize(r);
+    if constexpr (kExtraCheck)
+      benchmark::DoNotOptimize(posefuse::is_positive_semidefinite(ekf.covariance()));
+    if constexpr (kRecompute) {
+      auto r = ekf.update_with(fix, f.z[k]);
+      benchmark::DoNotOptimize(r);
+    } else {
+      auto r = ekf.update<0>(f.z[k]);
+      benchmark::DoNotOptimize(r);
+    }
     k = (k + 1) & 1023;
   }
   benchmark::DoNotOptimize(ekf.state());
 }
-BENCHMARK(BM_Seed000Ekf_Step_posefuse_recompute)->Name("BM_Seed000Ekf_Step/posefuse_recompute");
-
-void BM_Seed000Ekf_Step_posefuse_recompute_plus_check(benchmark::State& state) {
-  const Frames& f = frames();
-  const posefuse::PositionFix<2> fix = posefuse::PositionFix<2>::isotropic(0.5);
-  posefuse::Ekf<posefuse::PlanarDisplacement<double>, posefuse::PositionFix<2>> ekf(
-      posefuse::PlanarDisplacement<double>::from_sigmas(0.1, 0.1), fix);
-  ekf.reset(f.z[0], Eigen::Matrix2d::Identity());
-  std::size_t k = 0;
-  for (auto _ : state) {
-    benchmark::DoNotOptimize(ekf.predict(f.u[k], 1.0));
-    benchmark::DoNotOptimize(posefuse::is_positive_semidefinite(ekf.covariance()));
-    auto r = ekf.update_with(fix, f.z[k]);
-    benchmark::DoNotOptimize(r);
-    k = (k + 1) & 1023;
-  }
-  benchmark::DoNotOptimize(ekf.state());
-}
-BENCHMARK(BM_Seed000Ekf_Step_posefuse_recompute_plus_check)
+BENCHMARK_TEMPLATE(BM_Seed000Ekf_Step_posefuse_variant, false, false)
+    ->Name("BM_Seed000Ekf_Step/posefuse");
+BENCHMARK_TEMPLATE(BM_Seed000Ekf_Step_posefuse_variant, false, true)
+    ->Name("BM_Seed000Ekf_Step/posefuse_plus_check");
+BENCHMARK_TEMPLATE(BM_Seed000Ekf_Step_posefuse_variant, true, false)
+    ->Name("BM_Seed000Ekf_Step/posefuse_recompute");
+BENCHMARK_TEMPLATE(BM_Seed000Ekf_Step_posefuse_variant, true, true)
     ->Name("BM_Seed000Ekf_Step/posefuse_recompute_plus_check");
 
 void BM_Seed000Ekf_Step_naive_fixed(benchmark::State& state) {
@@ -182,7 +147,9 @@ void BM_Seed000Ekf_Step_dynamic(benchmark::State& state) {
 }
 BENCHMARK(BM_Seed000Ekf_Step_dynamic)->Name("BM_Seed000Ekf_Step/dynamic");
 
-void BM_ConstantVelocityEkf_Step(benchmark::State& state) {
+// The constant-velocity step; kExtraCheck as above.
+template <bool kExtraCheck>
+void BM_ConstantVelocityEkf_Step_variant(benchmark::State& state) {
   const Frames& f = frames();
   posefuse::Ekf<posefuse::ConstantVelocity2<double>, posefuse::PositionFix<4>> ekf(
       posefuse::ConstantVelocity2<double>(1.0), posefuse::PositionFix<4>::isotropic(0.5));
@@ -192,30 +159,16 @@ void BM_ConstantVelocityEkf_Step(benchmark::State& state) {
   std::size_t k = 0;
   for (auto _ : state) {
     benchmark::DoNotOptimize(ekf.predict(posefuse::NoControl{}, 0.1));
+    if constexpr (kExtraCheck)
+      benchmark::DoNotOptimize(posefuse::is_positive_semidefinite(ekf.covariance()));
     auto r = ekf.update<0>(f.z[k]);
     benchmark::DoNotOptimize(r);
     k = (k + 1) & 1023;
   }
 }
-BENCHMARK(BM_ConstantVelocityEkf_Step);
-
-void BM_ConstantVelocityEkf_Step_plus_check(benchmark::State& state) {
-  const Frames& f = frames();
-  posefuse::Ekf<posefuse::ConstantVelocity2<double>, posefuse::PositionFix<4>> ekf(
-      posefuse::ConstantVelocity2<double>(1.0), posefuse::PositionFix<4>::isotropic(0.5));
-  Eigen::Vector4d x0;
-  x0 << f.z[0], 0, 0;
-  ekf.reset(x0, Eigen::Matrix4d::Identity());
-  std::size_t k = 0;
-  for (auto _ : state) {
-    benchmark::DoNotOptimize(ekf.predict(posefuse::NoControl{}, 0.1));
-    benchmark::DoNotOptimize(posefuse::is_positive_semidefinite(ekf.covariance()));
-    auto r = ekf.update<0>(f.z[k]);
-    benchmark::DoNotOptimize(r);
-    k = (k + 1) & 1023;
-  }
-}
-BENCHMARK(BM_ConstantVelocityEkf_Step_plus_check)->Name("BM_ConstantVelocityEkf_Step_plus_check");
+BENCHMARK_TEMPLATE(BM_ConstantVelocityEkf_Step_variant, false)->Name("BM_ConstantVelocityEkf_Step");
+BENCHMARK_TEMPLATE(BM_ConstantVelocityEkf_Step_variant, true)
+    ->Name("BM_ConstantVelocityEkf_Step_plus_check");
 
 // Covariances as the filters above produce them (predicted and posterior,
 // the first 128 steps of each, so they still change), cycled.
