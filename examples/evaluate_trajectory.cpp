@@ -30,21 +30,28 @@
 //
 // prints rmse 12.978526 m and "scale 24.841695". Add --metric rpe --delta 100
 // --delta-unit m for the relative error per 100 m, --json for machine-readable
-// output. Bad input exits with 2 (usage) or 1 (data, naming file:line where
-// a file is at fault), one line on stderr.
+// output, --save-results FILE to keep everything (statistics, per-pose errors,
+// options) as JSON. evo_ape / evo_rpe options are spelled with dashes
+// (--t-offset, --align-origin, --n-to-align, ...; see --help and README).
+// Repeated timestamps are kept first by default (--duplicates) and reported
+// as a "warning:" line on stderr. Bad input exits with 2 (usage) or 1 (data,
+// naming file:line where a file is at fault), one line on stderr.
 
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include <apps/cli.hpp>
 #include <apps/json.hpp>
+#include <apps/output_file.hpp>
 #include <posefuse/eval/metrics.hpp>
+#include <posefuse/eval/trajectory_filters.hpp>
 #include <posefuse/io/association.hpp>
 #include <posefuse/io/formats.hpp>
 
@@ -54,23 +61,41 @@ namespace apps = posefuse::apps;
 
 struct Options {
   std::filesystem::path groundtruth, estimate;
-  std::optional<std::filesystem::path> times;
+  std::optional<std::filesystem::path> times, save_results;
   posefuse::Format ref_format = posefuse::Format::kKitti;
   posefuse::Format est_format = posefuse::Format::kKitti;
+  posefuse::DuplicateStamps duplicates = posefuse::DuplicateStamps::kFirst;
   bool metric_rpe = false;
-  posefuse::Alignment align = posefuse::Alignment::kNone;
   posefuse::PoseRelation relation = posefuse::PoseRelation::kTranslation;
-  double delta = 1.0;
-  posefuse::DeltaUnit delta_unit = posefuse::DeltaUnit::kFrames;
+  posefuse::RpeOptions rpe;  // delta, unit, all pairs, tolerance, pair source
+  posefuse::AlignmentOptions align;
   double max_time_diff = 0.01;
+  double t_offset = 0.0;
+  std::optional<double> t_start, t_end;
+  std::optional<std::size_t> downsample;
+  std::optional<std::pair<double, double>> motion_filter;  // m, deg
   bool json = false;
 };
+
+/// "D,A" -> (D, A), both finite and >= 0.
+std::pair<double, double> parse_pair(std::string_view v) {
+  const auto comma = v.find(',');
+  if (comma == std::string_view::npos)
+    throw apps::usage_error("expected DIST,ANGLE (two numbers separated by a comma), got '" +
+                            std::string(v) + "'");
+  return {apps::parse_real(v.substr(0, comma), apps::Domain::kNonNegative),
+          apps::parse_real(v.substr(comma + 1), apps::Domain::kNonNegative)};
+}
 
 /// The options, or nothing when --help was printed.
 std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   Options o;
   std::optional<std::filesystem::path> ref, est;
   std::optional<posefuse::Format> format, ref_format, est_format;
+  std::optional<double> t_start, t_end;
+  std::optional<std::size_t> n_to_align;
+  bool all_pairs = false, pairs_from_reference = false;
+  double delta_tol = o.rpe.delta_tol;
   const auto format_flag = [](std::optional<posefuse::Format>& f) {
     return [&f](std::string_view v) { f = posefuse::parse_format(v); };
   };
@@ -90,28 +115,73 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
              format_flag(est_format));
   cli.path({.name = "--times", .value = "FILE", .help = "KITTI times.txt, stamps every KITTI file given"},
            o.times);
+  cli.custom({.name = "--duplicates", .value = "first|last|error",
+              .help = "equal consecutive stamps: keep the first or last pose (reported\n"
+                      "as a warning) or refuse the file",
+              .default_text = "first"},
+             [&](std::string_view v) { o.duplicates = posefuse::parse_duplicate_stamps(v); });
   cli.custom({.name = "--metric", .value = "ape|rpe", .help = "the error", .default_text = "ape"},
              [&](std::string_view v) {
                if (v != "ape" && v != "rpe")
                  throw apps::usage_error("expected ape or rpe, got '" + std::string(v) + "'");
                o.metric_rpe = v == "rpe";
              });
-  cli.custom({.name = "--align", .value = "none|se3|sim3", .help = "Umeyama alignment of EST to REF",
+  cli.custom({.name = "--align", .value = "none|se3|sim3|scale",
+              .help = "Umeyama alignment of EST to REF (scale: scale only,\n"
+                      "evo's --correct_scale without --align)",
               .default_text = "none"},
-             [&](std::string_view v) { o.align = posefuse::parse_alignment(v); });
+             [&](std::string_view v) { o.align.alignment = posefuse::parse_alignment(v); });
+  cli.flag({.name = "--align-origin", .help = "move EST so that its first pose is REF's first pose"},
+           o.align.align_origin);
+  cli.integer({.name = "--n-to-align", .value = "N",
+               .help = "compute the alignment from the first N pose pairs only"},
+              n_to_align, std::size_t{3});
+  cli.custom({.name = "--project-to-plane", .value = "xy|xz|yz",
+              .help = "project both trajectories onto a plane after alignment"},
+             [&](std::string_view v) { o.align.project_to_plane = posefuse::parse_plane(v); });
   cli.custom({.name = "--pose-relation", .value = "R",
-              .help = "trans, angle_deg, angle_rad or full", .default_text = "trans"},
+              .help = "trans, angle_deg, angle_rad, full, rot_part, point_distance,\n"
+                      "point_distance_error_ratio (RPE only)",
+              .default_text = "trans"},
              [&](std::string_view v) { o.relation = posefuse::parse_pose_relation(v); });
-  cli.real({.name = "--delta", .value = "N", .help = "RPE step"}, o.delta, apps::Domain::kPositive);
-  cli.custom({.name = "--delta-unit", .value = "frames|m", .help = "RPE step unit",
+  cli.real({.name = "--delta", .value = "N", .help = "RPE step"}, o.rpe.delta,
+           apps::Domain::kPositive);
+  cli.custom({.name = "--delta-unit", .value = "frames|m|deg|rad", .help = "RPE step unit",
               .default_text = "frames"},
-             [&](std::string_view v) { o.delta_unit = posefuse::parse_delta_unit(v); });
+             [&](std::string_view v) { o.rpe.delta_unit = posefuse::parse_delta_unit(v); });
+  cli.flag({.name = "--all-pairs", .help = "RPE over every start pose, not consecutive pairs"},
+           all_pairs);
+  cli.real({.name = "--delta-tol", .value = "F",
+            .help = "relative tolerance of --all-pairs with m/deg/rad deltas"},
+           delta_tol, apps::Domain::kNonNegative);
+  cli.flag({.name = "--pairs-from-reference",
+            .help = "choose RPE pairs on REF instead of the aligned EST"},
+           pairs_from_reference);
   cli.real({.name = "--max-time-diff", .value = "S", .help = "association tolerance", .unit = "s"},
            o.max_time_diff, apps::Domain::kNonNegative);
+  cli.real({.name = "--t-offset", .value = "S", .help = "constant offset added to EST's stamps",
+            .unit = "s"},
+           o.t_offset);
+  cli.custom({.name = "--t-start", .value = "S", .help = "first REF stamp used (absolute, s)"},
+             [&](std::string_view v) { t_start = apps::parse_real(v); });
+  cli.custom({.name = "--t-end", .value = "S", .help = "last REF stamp used (absolute, s)"},
+             [&](std::string_view v) { t_end = apps::parse_real(v); });
+  cli.integer({.name = "--downsample", .value = "N",
+               .help = "keep at most N evenly spaced poses of each file"},
+              o.downsample, std::size_t{1});
+  cli.custom({.name = "--motion-filter", .value = "DIST,DEG",
+              .help = "keep a pose only after DIST m or DEG degrees of motion\n"
+                      "since the last kept one (each file)"},
+             [&](std::string_view v) { o.motion_filter = parse_pair(v); });
+  cli.path({.name = "--save-results", .value = "FILE",
+            .help = "write statistics, per-pose errors and options as JSON"},
+           o.save_results);
   cli.flag({.name = "--json", .help = "print one JSON object instead of the table"}, o.json);
   cli.epilogue(
       "Two KITTI files without --times are compared frame by frame (equal counts);\n"
       "otherwise poses are associated by timestamp like evo's --t_max_diff.\n"
+      "Order as evo: --downsample/--motion-filter, --t-start/--t-end (REF),\n"
+      "association (--t-offset), alignment, --project-to-plane, metric.\n"
       "Exit status: 0 ok, 1 bad data (file:line where a file is at fault), 2 bad usage.");
   if (!cli.parse(cmd)) return std::nullopt;
 
@@ -125,16 +195,57 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   if (o.times && !any_kitti) throw apps::usage_error("--times only applies to KITTI files");
   if (o.ref_format != o.est_format && !o.times)
     throw apps::usage_error("comparing a KITTI with a TUM file needs --times for the KITTI one");
-  if (o.delta_unit == posefuse::DeltaUnit::kFrames &&
-      (o.delta < 1.0 || o.delta != std::floor(o.delta)))
+  o.rpe.all_pairs = all_pairs;
+  o.rpe.delta_tol = delta_tol;
+  o.rpe.pairs_from_reference = pairs_from_reference;
+  o.rpe.relation = o.relation;
+  if (o.rpe.delta_unit == posefuse::DeltaUnit::kFrames &&
+      (o.rpe.delta < 1.0 || o.rpe.delta != std::floor(o.rpe.delta)))
     throw apps::usage_error("--delta in frames must be an integer >= 1");
+  if (!o.metric_rpe && o.relation == posefuse::PoseRelation::kPointDistanceErrorRatio)
+    throw apps::usage_error("--pose-relation point_distance_error_ratio needs --metric rpe");
+  if (o.align.align_origin && o.align.alignment != posefuse::Alignment::kNone)
+    throw apps::usage_error("--align-origin and --align exclude each other");
+  if (n_to_align) {
+    if (o.align.alignment == posefuse::Alignment::kNone)
+      throw apps::usage_error("--n-to-align needs --align se3, sim3 or scale");
+    o.align.n_to_align = *n_to_align;
+  }
+  if (t_start && t_end && *t_start > *t_end)
+    throw apps::usage_error("--t-start is after --t-end");
+  o.t_start = t_start;
+  o.t_end = t_end;
+  const bool frame_by_frame = o.ref_format == posefuse::Format::kKitti &&
+                              o.est_format == posefuse::Format::kKitti && !o.times;
+  if (frame_by_frame && (o.motion_filter || o.t_start || o.t_end || o.t_offset != 0.0))
+    throw apps::usage_error(
+        "--motion-filter, --t-start, --t-end and --t-offset need timestamps: give --times "
+        "(KITTI files without it are compared frame by frame)");
+  o.rpe.alignment = o.align.alignment;
+  o.rpe.n_to_align = o.align.n_to_align;
+  o.rpe.align_origin = o.align.align_origin;
+  o.rpe.project_to_plane = o.align.project_to_plane;
   return o;
 }
 
 posefuse::Trajectory load(const std::filesystem::path& file, posefuse::Format format,
-                          const std::optional<std::filesystem::path>& times) {
-  return format == posefuse::Format::kKitti ? posefuse::read_kitti(file, times)
-                                            : posefuse::read_tum(file);
+                          const std::optional<std::filesystem::path>& times,
+                          posefuse::DuplicateStamps duplicates, std::vector<std::string>& warnings) {
+  posefuse::ReadOptions options;
+  options.duplicates = duplicates;
+  posefuse::ReadReport report;
+  posefuse::Trajectory traj = format == posefuse::Format::kKitti
+                                  ? posefuse::read_kitti(file, times, options, &report)
+                                  : posefuse::read_tum(file, options, &report);
+  if (report.duplicates_dropped > 0) {
+    const std::filesystem::path& where = format == posefuse::Format::kKitti ? *times : file;
+    warnings.push_back(where.string() + ":" + std::to_string(report.first_duplicate_line) +
+                       ": " + std::to_string(report.duplicates_dropped) +
+                       " pose(s) with a repeated timestamp dropped (kept the " +
+                       std::string(posefuse::to_string(duplicates)) +
+                       " of each run; --duplicates error refuses them)");
+  }
+  return traj;
 }
 
 std::string relation_title(posefuse::PoseRelation r) {
@@ -143,28 +254,33 @@ std::string relation_title(posefuse::PoseRelation r) {
     case posefuse::PoseRelation::kRotationAngleDeg: return "rotation angle in degrees (deg)";
     case posefuse::PoseRelation::kRotationAngleRad: return "rotation angle in radians (rad)";
     case posefuse::PoseRelation::kFull: return "full transformation (unit-less)";
+    case posefuse::PoseRelation::kRotationPart: return "rotation part (unit-less)";
+    case posefuse::PoseRelation::kPointDistance: return "point distance (m)";
+    case posefuse::PoseRelation::kPointDistanceErrorRatio: return "point distance error ratio (%)";
   }
   return "?";
 }
 
+/// The --pose-relation spelling ("trans" for the translation part).
 std::string_view relation_name(posefuse::PoseRelation r) {
-  switch (r) {
-    case posefuse::PoseRelation::kTranslation: return "trans";
-    case posefuse::PoseRelation::kRotationAngleDeg: return "angle_deg";
-    case posefuse::PoseRelation::kRotationAngleRad: return "angle_rad";
-    case posefuse::PoseRelation::kFull: return "full";
-  }
-  return "?";
+  return r == posefuse::PoseRelation::kTranslation ? "trans" : posefuse::to_string(r);
+}
+
+std::string alignment_name(const Options& o) {
+  if (o.align.align_origin) return "origin";
+  return std::string(posefuse::to_string(o.align.alignment));
 }
 
 void print_table(const Options& o, const posefuse::MetricResult& r, std::size_t n_ref,
                  std::size_t n_est) {
   std::printf("%s w.r.t. %s, alignment %s", o.metric_rpe ? "RPE" : "APE",
-              relation_title(o.relation).c_str(),
-              std::string(posefuse::to_string(o.align)).c_str());
+              relation_title(o.relation).c_str(), alignment_name(o).c_str());
+  if (o.align.n_to_align > 0) std::printf(" (first %zu poses)", o.align.n_to_align);
+  if (o.align.project_to_plane)
+    std::printf(", projected to %s", std::string(posefuse::to_string(*o.align.project_to_plane)).c_str());
   if (o.metric_rpe) {
-    std::printf(", delta %g %s", o.delta,
-                o.delta_unit == posefuse::DeltaUnit::kFrames ? "frames" : "m");
+    std::printf(", delta %g %s%s", o.rpe.delta, std::string(posefuse::to_string(o.rpe.delta_unit)).c_str(),
+                o.rpe.all_pairs ? ", all pairs" : "");
   }
   std::printf("\n");
   std::printf("pairs  %11zu\n", r.stats.count);
@@ -175,31 +291,97 @@ void print_table(const Options& o, const posefuse::MetricResult& r, std::size_t 
   std::printf("max    %11.6f\nmean   %11.6f\nmedian %11.6f\nmin    %11.6f\n", s.max, s.mean,
               s.median, s.min);
   std::printf("rmse   %11.6f\nsse    %11.6f\nstd    %11.6f\n", s.rmse, s.sse, s.std);
-  if (o.align == posefuse::Alignment::kSim3) std::printf("scale  %11.6f\n", r.alignment.scale);
+  if (o.align.alignment == posefuse::Alignment::kSim3 ||
+      o.align.alignment == posefuse::Alignment::kScale)
+    std::printf("scale  %11.6f\n", r.alignment.scale);
+}
+
+/// The summary members shared by --json and --save-results.
+void write_summary(apps::JsonWriter& j, const Options& o, const posefuse::MetricResult& r) {
+  const posefuse::Statistics& s = r.stats;
+  j.member("metric", o.metric_rpe ? "rpe" : "ape")
+      .member("pose_relation", relation_name(o.relation))
+      .member("unit", posefuse::unit_of(o.relation))
+      .member("alignment", alignment_name(o))
+      .member("scale", r.alignment.scale);
+  if (o.metric_rpe) {
+    j.member("delta", o.rpe.delta).member("delta_unit", posefuse::to_string(o.rpe.delta_unit));
+  }
+  j.member("count", s.count).member("rmse", s.rmse).member("mean", s.mean).member("median", s.median);
+  j.member("std", s.std).member("min", s.min).member("max", s.max).member("sse", s.sse);
 }
 
 /// One JSON object on one line; numbers round-trip, non-finite ones are null.
 void print_json(const Options& o, const posefuse::MetricResult& r) {
-  const posefuse::Statistics& s = r.stats;
   apps::JsonWriter j(std::cout);
   j.begin_object(apps::JsonWriter::Layout::kInline);
-  j.member("metric", o.metric_rpe ? "rpe" : "ape")
-      .member("pose_relation", relation_name(o.relation))
-      .member("unit", posefuse::unit_of(o.relation))
-      .member("alignment", posefuse::to_string(o.align))
-      .member("scale", r.alignment.scale);
-  if (o.metric_rpe) {
-    j.member("delta", o.delta)
-        .member("delta_unit", o.delta_unit == posefuse::DeltaUnit::kFrames ? "frames" : "m");
-  }
-  j.member("count", s.count).member("rmse", s.rmse).member("mean", s.mean).member("median", s.median);
-  j.member("std", s.std).member("min", s.min).member("max", s.max).member("sse", s.sse);
+  write_summary(j, o, r);
   j.end_object().finish();
 }
 
+/// The --save-results document: the summary, the options that shaped it,
+/// and per pose (APE) or pair (RPE) the stamp(s) and the error.
+std::string results_json(const Options& o, const posefuse::MetricResult& r,
+                         const posefuse::Trajectory& ref_used,
+                         const std::vector<std::string>& warnings) {
+  std::ostringstream out;
+  apps::JsonWriter j(out);
+  j.begin_object();
+  write_summary(j, o, r);
+  j.key("options").begin_object();
+  j.member("groundtruth", o.groundtruth.string()).member("estimate", o.estimate.string());
+  j.member("groundtruth_format", posefuse::to_string(o.ref_format))
+      .member("estimate_format", posefuse::to_string(o.est_format));
+  j.member("duplicates", posefuse::to_string(o.duplicates));
+  j.member("n_to_align", o.align.n_to_align);
+  j.member("project_to_plane",
+           o.align.project_to_plane ? posefuse::to_string(*o.align.project_to_plane) : "none");
+  j.member("max_time_diff_s", o.max_time_diff).member("t_offset_s", o.t_offset);
+  j.member("t_start_s", o.t_start ? *o.t_start : std::nan(""))
+      .member("t_end_s", o.t_end ? *o.t_end : std::nan(""));
+  j.member("downsample", o.downsample ? static_cast<double>(*o.downsample) : std::nan(""));
+  j.member("motion_filter_m", o.motion_filter ? o.motion_filter->first : std::nan(""))
+      .member("motion_filter_deg", o.motion_filter ? o.motion_filter->second : std::nan(""));
+  if (o.metric_rpe) {
+    j.member("all_pairs", o.rpe.all_pairs).member("delta_tol", o.rpe.delta_tol);
+    j.member("pairs_from_reference", o.rpe.pairs_from_reference);
+  }
+  j.end_object();
+  j.key("warnings").begin_array();
+  for (const std::string& w : warnings) j.value(w);
+  j.end_array();
+  j.key("errors").begin_array();
+  for (const double e : r.errors) j.value(e);
+  j.end_array();
+  // Stamps of the reference pose each error belongs to (RPE: the pair's end).
+  j.key("stamps_s").begin_array();
+  if (o.metric_rpe) {
+    for (const auto& pair : r.pairs) j.value(ref_used.t_s[pair.second]);
+  } else {
+    for (const double t : ref_used.t_s) j.value(t);
+  }
+  j.end_array();
+  j.end_object().finish();
+  return out.str();
+}
+
+posefuse::Trajectory thin(const posefuse::Trajectory& traj, const Options& o) {
+  posefuse::Trajectory out = traj;
+  if (o.downsample) out = posefuse::downsample(out, *o.downsample);
+  if (o.motion_filter) {
+    out = posefuse::motion_filter(out, o.motion_filter->first,
+                                  o.motion_filter->second * std::numbers::pi / 180.0);
+  }
+  return out;
+}
+
 int run(const Options& o) {
-  const posefuse::Trajectory ref = load(o.groundtruth, o.ref_format, o.times);
-  const posefuse::Trajectory est = load(o.estimate, o.est_format, o.times);
+  std::vector<std::string> warnings;
+  const posefuse::Trajectory ref_file = load(o.groundtruth, o.ref_format, o.times, o.duplicates, warnings);
+  const posefuse::Trajectory est_file = load(o.estimate, o.est_format, o.times, o.duplicates, warnings);
+  for (const std::string& w : warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  posefuse::Trajectory ref = thin(ref_file, o);
+  const posefuse::Trajectory est = thin(est_file, o);
   posefuse::Trajectory ref_sync, est_sync;
   const bool frame_by_frame = o.ref_format == posefuse::Format::kKitti &&
                               o.est_format == posefuse::Format::kKitti && !o.times;
@@ -212,25 +394,31 @@ int run(const Options& o) {
     ref_sync = ref;
     est_sync = est;
   } else {
-    posefuse::AssociatedTrajectories sync = posefuse::associate(ref, est, o.max_time_diff);
+    if (o.t_start || o.t_end) {
+      ref = posefuse::reduce_to_time_range(ref, o.t_start, o.t_end);
+      if (ref.empty()) {
+        throw apps::data_error(o.groundtruth.string() + ": no pose between --t-start and --t-end (" +
+                               apps::shortest(ref_file.t_s.front()) + " to " +
+                               apps::shortest(ref_file.t_s.back()) + " s in the file)");
+      }
+    }
+    posefuse::AssociatedTrajectories sync = posefuse::associate(ref, est, o.max_time_diff, o.t_offset);
     ref_sync = std::move(sync.ref);
     est_sync = std::move(sync.est);
   }
-  posefuse::MetricResult result;
-  if (o.metric_rpe) {
-    posefuse::RpeOptions rpe_options;
-    rpe_options.relation = o.relation;
-    rpe_options.delta = o.delta;
-    rpe_options.delta_unit = o.delta_unit;
-    rpe_options.alignment = o.align;
-    result = posefuse::rpe(ref_sync, est_sync, rpe_options);
-  } else {
-    result = posefuse::ape(ref_sync, est_sync, o.relation, o.align);
+  if (o.align.n_to_align > ref_sync.size()) {
+    throw apps::data_error("--n-to-align " + std::to_string(o.align.n_to_align) + " but only " +
+                           std::to_string(ref_sync.size()) + " poses are associated");
   }
+  posefuse::MetricResult result = o.metric_rpe ? posefuse::rpe(ref_sync, est_sync, o.rpe)
+                                               : posefuse::ape(ref_sync, est_sync, o.relation, o.align);
+  apps::OutputFiles outputs;
+  if (o.save_results) outputs.add(*o.save_results, results_json(o, result, ref_sync, warnings));
+  outputs.commit();
   if (o.json) {
     print_json(o, result);
   } else {
-    print_table(o, result, ref.size(), est.size());
+    print_table(o, result, ref_file.size(), est_file.size());
   }
   return 0;
 }

@@ -133,5 +133,5 @@ TEST_CASE("Alignment: align_trajectory undoes a Sim(3) on a synthetic drive", "[
   shorter.poses.pop_back();
   shorter.t_s.pop_back();
   CHECK_THROWS_WITH(posefuse::align_trajectory(shorter, ref, posefuse::Alignment::kSE3),
-                    Catch::Contains("associate them first"));
+                    Catch::Contains("call associate() first"));
 }

@@ -5,11 +5,14 @@
 #include <catch2/catch.hpp>
 
 #include <filesystem>
+#include <iterator>
+#include <numbers>
 #include <fstream>
 #include <string>
 #include <utility>
 
 #include <posefuse/eval/metrics.hpp>
+#include <posefuse/eval/trajectory_filters.hpp>
 #include <posefuse/io/association.hpp>
 #include <posefuse/io/formats.hpp>
 
@@ -127,4 +130,167 @@ TEST_CASE("Evaluate CLI: JSON output equals the library and errors exit cleanly"
     CHECK(far.status == 1);
     CHECK(far.err.find("found no matching timestamps") != std::string::npos);
   }
+}
+
+TEST_CASE("Evaluate CLI: evo options reach the library unchanged", "[eval][cli][evo-options]") {
+  POSEFUSE_REQUIRE_EXAMPLE(exe, "evaluate_trajectory");
+  posefuse::test::TempDir dir("cli-evo");
+  const posefuse::Trajectory ref = posefuse::test::make_vehicle_trajectory(300, 31, 1000.0);
+  posefuse::Trajectory est = posefuse::test::perturb(ref, 0.2, 0.01, 32);
+  for (double& t : est.t_s) t += 0.25;  // a 0.25 s clock offset: needs --t-offset
+  posefuse::write_tum(dir.path() / "ref.tum", ref);
+  posefuse::write_tum(dir.path() / "est.tum", est);
+  const std::string files = "--format tum --groundtruth '" + (dir.path() / "ref.tum").string() +
+                            "' --estimate '" + (dir.path() / "est.tum").string() + "' --json";
+  const posefuse::Trajectory ref_read = posefuse::read_tum(dir.path() / "ref.tum");
+  const posefuse::Trajectory est_read = posefuse::read_tum(dir.path() / "est.tum");
+  const posefuse::AssociatedTrajectories sync = posefuse::associate(ref_read, est_read, 0.01, -0.25);
+  REQUIRE(sync.ref.size() == 300);
+
+  const auto rmse_of = [&](const std::string& args) {
+    const Run r = run(exe, files + " --t-offset -0.25 " + args, dir);
+    INFO(args << "\n" << r.err);
+    REQUIRE(r.status == 0);
+    return Json::parse(r.out)["rmse"].number();
+  };
+  SECTION("without --t-offset nothing matches, and the message says why") {
+    const Run r = run(exe, files, dir);
+    CHECK(r.status == 1);
+    CHECK(r.err.find("found no matching timestamps") != std::string::npos);
+  }
+  SECTION("alignment options") {
+    posefuse::AlignmentOptions a;
+    a.alignment = posefuse::Alignment::kScale;
+    CHECK(rmse_of("--align scale") ==
+          posefuse::ape(sync.ref, sync.est, posefuse::PoseRelation::kTranslation, a).stats.rmse);
+    a.alignment = posefuse::Alignment::kSE3;
+    a.n_to_align = 50;
+    CHECK(rmse_of("--align se3 --n-to-align 50") ==
+          posefuse::ape(sync.ref, sync.est, posefuse::PoseRelation::kTranslation, a).stats.rmse);
+    a = {};
+    a.align_origin = true;
+    CHECK(rmse_of("--align-origin") ==
+          posefuse::ape(sync.ref, sync.est, posefuse::PoseRelation::kTranslation, a).stats.rmse);
+    a.project_to_plane = posefuse::Plane::kXZ;
+    CHECK(rmse_of("--align-origin --project-to-plane xz") ==
+          posefuse::ape(sync.ref, sync.est, posefuse::PoseRelation::kTranslation, a).stats.rmse);
+  }
+  SECTION("RPE options") {
+    posefuse::RpeOptions o;
+    o.relation = posefuse::PoseRelation::kPointDistanceErrorRatio;
+    o.delta = 20.0;
+    o.delta_unit = posefuse::DeltaUnit::kMeters;
+    o.all_pairs = true;
+    o.delta_tol = 0.05;
+    CHECK(rmse_of("--metric rpe --pose-relation point_distance_error_ratio --delta 20 "
+                  "--delta-unit m --all-pairs --delta-tol 0.05") ==
+          posefuse::rpe(sync.ref, sync.est, o).stats.rmse);
+    o = {};
+    o.relation = posefuse::PoseRelation::kRotationPart;
+    o.delta = 5.0;
+    o.delta_unit = posefuse::DeltaUnit::kDegrees;
+    CHECK(rmse_of("--metric rpe --pose-relation rot_part --delta 5 --delta-unit deg") ==
+          posefuse::rpe(sync.ref, sync.est, o).stats.rmse);
+  }
+  SECTION("selection before association: time range, down-sampling, motion filter") {
+    const posefuse::Trajectory ranged = posefuse::reduce_to_time_range(ref_read, 1010.0, 1020.0);
+    const auto s1 = posefuse::associate(ranged, est_read, 0.01, -0.25);
+    CHECK(rmse_of("--t-start 1010 --t-end 1020") == posefuse::ape(s1.ref, s1.est).stats.rmse);
+    const auto s2 = posefuse::associate(posefuse::downsample(ref_read, 40),
+                                        posefuse::downsample(est_read, 40), 0.01, -0.25);
+    CHECK(rmse_of("--downsample 40") == posefuse::ape(s2.ref, s2.est).stats.rmse);
+    const double deg = std::numbers::pi / 180.0;
+    const auto s3 = posefuse::associate(posefuse::motion_filter(ref_read, 2.0, 5.0 * deg),
+                                        posefuse::motion_filter(est_read, 2.0, 5.0 * deg), 0.01,
+                                        -0.25);
+    CHECK(rmse_of("--motion-filter 2,5") == posefuse::ape(s3.ref, s3.est).stats.rmse);
+    const Run none = run(exe, files + " --t-offset -0.25 --t-start 5000", dir);
+    CHECK(none.status == 1);
+    CHECK(none.err.find("no pose between --t-start and --t-end") != std::string::npos);
+  }
+  SECTION("--save-results keeps statistics, per-pose errors and options") {
+    const auto out = dir.path() / "res.json";
+    const Run r = run(exe, files + " --t-offset -0.25 --align se3 --save-results '" + out.string() + "'", dir);
+    REQUIRE(r.status == 0);
+    std::ifstream in(out);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const Json j = Json::parse(text);
+    const auto lib = posefuse::ape(sync.ref, sync.est, posefuse::PoseRelation::kTranslation,
+                                   posefuse::Alignment::kSE3);
+    CHECK(j["rmse"].number() == lib.stats.rmse);
+    REQUIRE(j["errors"].array().size() == 300);
+    CHECK(j["errors"][17].number() == lib.errors[17]);
+    CHECK(j["stamps_s"][17].number() == sync.ref.t_s[17]);
+    CHECK(j["options"]["t_offset_s"].number() == -0.25);
+    CHECK(j["options"]["duplicates"].string() == "first");
+  }
+  SECTION("usage errors for the new options exit 2") {
+    for (const std::string& args :
+         {files + " --align-origin --align se3", files + " --n-to-align 10",
+          files + " --n-to-align 2 --align se3", files + " --pose-relation point_distance_error_ratio",
+          files + " --t-start 5 --t-end 4", files + " --downsample 0", files + " --motion-filter 1",
+          files + " --motion-filter 1,-2", files + " --duplicates keep", files + " --delta-tol -1"}) {
+      INFO(args);
+      const Run r = run(exe, args, dir);
+      CHECK(r.status == 2);
+      CHECK(count_lines(r.err) == 1);
+    }
+  }
+}
+
+TEST_CASE("Evaluate CLI: repeated stamps, byte-order marks and stamp units", "[eval][cli][input-policy]") {
+  POSEFUSE_REQUIRE_EXAMPLE(exe, "evaluate_trajectory");
+  posefuse::test::TempDir dir("cli-input");
+  const posefuse::Trajectory ref = posefuse::test::make_vehicle_trajectory(50, 41, 100.0);
+  posefuse::write_tum(dir.path() / "ref.tum", ref);
+  // The estimate repeats the stamp of its line 11 twice (lines 12 and 13).
+  std::ifstream in(dir.path() / "ref.tum");
+  std::string line, text;
+  int n = 0;
+  while (std::getline(in, line)) {
+    text += line + "\n";
+    if (++n == 11) text += line + "\n" + line + "\n";
+  }
+  std::ofstream(dir.path() / "dup.tum") << text;
+  const std::string files = "--format tum --groundtruth '" + (dir.path() / "ref.tum").string() +
+                            "' --estimate '" + (dir.path() / "dup.tum").string() + "'";
+  const Run first = run(exe, files + " --json", dir);
+  REQUIRE(first.status == 0);
+  CHECK(count_lines(first.err) == 1);
+  CHECK(first.err.rfind("warning: " + (dir.path() / "dup.tum").string() + ":12: 2 pose(s) with a repeated timestamp dropped", 0) == 0);
+  CHECK(Json::parse(first.out)["count"].number() == 50.0);
+  CHECK(Json::parse(first.out)["rmse"].number() == 0.0);
+  const Run last = run(exe, files + " --duplicates last --json", dir);
+  CHECK(last.status == 0);
+  const Run refused = run(exe, files + " --duplicates error", dir);
+  CHECK(refused.status == 1);
+  CHECK(refused.err.find("dup.tum:12: timestamp") != std::string::npos);
+  CHECK(refused.err.find("repeats the previous one") != std::string::npos);
+
+  // A byte-order mark in front of the first stamp.
+  std::ofstream(dir.path() / "bom.tum") << "\xEF\xBB\xBF" << text;
+  const Run bom = run(exe, "--format tum --groundtruth '" + (dir.path() / "ref.tum").string() +
+                               "' --estimate '" + (dir.path() / "bom.tum").string() + "' --json",
+                      dir);
+  CHECK(bom.status == 0);
+
+  // Nanosecond stamps against seconds: the error says so.
+  posefuse::Trajectory ns = ref;
+  for (double& t : ns.t_s) t *= 1e9;
+  posefuse::write_tum(dir.path() / "ns.tum", ns);
+  const Run units = run(exe, "--format tum --groundtruth '" + (dir.path() / "ref.tum").string() +
+                                 "' --estimate '" + (dir.path() / "ns.tum").string() + "'",
+                        dir);
+  CHECK(units.status == 1);
+  CHECK(units.err.find("is one file in ns and the other in s?") != std::string::npos);
+  // Same unit, another origin: the error suggests --t-offset.
+  posefuse::Trajectory shifted = ref;
+  for (double& t : shifted.t_s) t += 5000.0;
+  posefuse::write_tum(dir.path() / "shifted.tum", shifted);
+  const Run origin = run(exe, "--format tum --groundtruth '" + (dir.path() / "ref.tum").string() +
+                                  "' --estimate '" + (dir.path() / "shifted.tum").string() + "'",
+                         dir);
+  CHECK(origin.status == 1);
+  CHECK(origin.err.find("different time origins? A constant offset is given with --t-offset") !=
+        std::string::npos);
 }

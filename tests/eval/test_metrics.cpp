@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <posefuse/eval/metrics.hpp>
+#include <posefuse/eval/trajectory_filters.hpp>
 #include <posefuse/io/association.hpp>
 #include <posefuse/io/formats.hpp>
 
@@ -103,7 +104,7 @@ TEST_CASE("Metrics: APE with alignment removes a rigid / similarity offset",
   const auto ang =
       posefuse::ape(ref, est, PoseRelation::kRotationAngleDeg, posefuse::Alignment::kSE3);
   CHECK(ang.stats.max < 1e-9);
-  CHECK_THROWS_WITH(posefuse::ape(ref, straight_line(3)), Catch::Contains("associate them first"));
+  CHECK_THROWS_WITH(posefuse::ape(ref, straight_line(3)), Catch::Contains("call associate() first"));
 }
 
 TEST_CASE("Metrics: RPE by frames, by hand", "[eval][metrics][rpe]") {
@@ -311,4 +312,219 @@ TEST_CASE("Metrics: KITTI 06 ORB-SLAM2 mono needs Sim(3), scale about 24.8",
   CHECK(posefuse::rpe(sync.ref, sync.est, o).stats.rmse == Approx(9.460708).margin(1e-4));
   WARN("KITTI 06 mono: Sim(3) scale " << sim3.alignment.scale << ", APE RMSE " << sim3.stats.rmse
                                       << " m, SE(3) APE RMSE " << se3.stats.rmse << " m");
+}
+
+// ---------------------------------------------------------------------------
+// evo_ape / evo_rpe options (evaluation issue), each on a hand-worked case.
+
+namespace {
+
+posefuse::Trajectory line_along_x(const std::vector<double>& xs) {
+  posefuse::Trajectory traj;
+  for (std::size_t k = 0; k < xs.size(); ++k) traj.push_back(double(k), pose({xs[k], 0, 0}));
+  return traj;
+}
+
+Eigen::Isometry3d yaw_z(double yaw_rad, const Eigen::Vector3d& t = Eigen::Vector3d::Zero()) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  T.translation() = t;
+  return T;
+}
+
+}  // namespace
+
+TEST_CASE("Metrics: rot_part is |R(E) - I|_F = 2 sqrt(2) |sin(theta/2)|", "[eval][metrics][evo-options]") {
+  posefuse::Trajectory ref, est;
+  for (int k = 0; k < 4; ++k) {
+    ref.push_back(k, pose({double(k), 0, 0}));
+    est.push_back(k, pose({double(k), 0, 0}, 0.1 * k));
+  }
+  const auto r = posefuse::ape(ref, est, PoseRelation::kRotationPart);
+  for (int k = 0; k < 4; ++k) CHECK(r.errors[k] == Approx(2 * std::sqrt(2.0) * std::sin(0.05 * k)).margin(1e-15));
+  CHECK(posefuse::unit_of(PoseRelation::kRotationPart).empty());
+  CHECK(posefuse::parse_pose_relation("rot_part") == PoseRelation::kRotationPart);
+}
+
+TEST_CASE("Metrics: point_distance compares distances, not directions", "[eval][metrics][evo-options]") {
+  // The reference steps 1 m along x, the estimate 1.1 m along y: trans_part
+  // sees the whole direction error, point_distance only the 0.1 m of length.
+  posefuse::Trajectory ref, est;
+  for (int k = 0; k < 5; ++k) {
+    ref.push_back(k, pose({double(k), 0, 0}));
+    est.push_back(k, pose({0, 1.1 * k, 0}));
+  }
+  posefuse::RpeOptions o;
+  o.relation = PoseRelation::kPointDistance;
+  const auto d = posefuse::rpe(ref, est, o);
+  REQUIRE(d.errors.size() == 4);
+  for (const double e : d.errors) CHECK(e == Approx(0.1).margin(1e-14));
+  o.relation = PoseRelation::kPointDistanceErrorRatio;
+  const auto ratio = posefuse::rpe(ref, est, o);
+  for (const double e : ratio.errors) CHECK(e == Approx(10.0).margin(1e-12));
+  CHECK(posefuse::unit_of(PoseRelation::kPointDistanceErrorRatio) == "%");
+  o.relation = PoseRelation::kTranslation;
+  CHECK(posefuse::rpe(ref, est, o).errors[0] == Approx(std::hypot(1.0, 1.1)));
+  // APE point_distance = position distance; the ratio is RPE only.
+  const auto ape = posefuse::ape(ref, est, PoseRelation::kPointDistance);
+  CHECK(ape.errors[2] == Approx(std::hypot(2.0, 2.2)));
+  CHECK_THROWS_WITH(posefuse::ape(ref, est, PoseRelation::kPointDistanceErrorRatio),
+                    Catch::Contains("relative (RPE) measure"));
+  // A pair whose reference does not move has no ratio and is left out.
+  posefuse::Trajectory still = ref;
+  still.poses[1] = still.poses[0];
+  o.relation = PoseRelation::kPointDistanceErrorRatio;
+  const auto skipped = posefuse::rpe(still, est, o);
+  CHECK(skipped.errors.size() == 3);
+  CHECK(skipped.pairs.front() == std::pair<std::size_t, std::size_t>{1, 2});
+}
+
+TEST_CASE("Metrics: all pairs by index and by path with a tolerance", "[eval][metrics][evo-options]") {
+  CHECK(posefuse::rpe_pairs_by_index(5, 2, true) == Pairs{{0, 2}, {1, 3}, {2, 4}});
+  CHECK(posefuse::rpe_pairs_by_index(5, 2, false) == Pairs{{0, 2}, {2, 4}});
+  // Path 0, 1, 2, 3.5, 4 m; delta 2 m, tolerance 10 % = 0.2 m: pose 0 pairs
+  // with pose 2 (exactly 2 m), pose 1 finds 1 or 2.5 m (both too far), pose 2
+  // pairs with 4 (2 m), poses 3 and 4 have nothing 2 m ahead.
+  const posefuse::Trajectory t = line_along_x({0, 1, 2, 3.5, 4});
+  posefuse::RpeOptions o;
+  o.delta = 2.0;
+  o.delta_unit = posefuse::DeltaUnit::kMeters;
+  o.all_pairs = true;
+  CHECK(posefuse::rpe(t, t, o).pairs == Pairs{{0, 2}, {2, 4}});
+  o.delta_tol = 0.26;  // 0.52 m: pose 1 now pairs with pose 3 (2.5 m, 0.5 m off)
+  CHECK(posefuse::rpe(t, t, o).pairs == Pairs{{0, 2}, {1, 3}, {2, 4}});
+  o.delta = 10.0;
+  CHECK_THROWS_WITH(posefuse::rpe(t, t, o), Catch::Contains("or a larger --delta-tol"));
+  o.delta_tol = -1.0;
+  CHECK_THROWS_AS(posefuse::rpe(t, t, o), posefuse::invalid_argument);
+}
+
+TEST_CASE("Metrics: RPE by rotation angle in degrees and radians", "[eval][metrics][evo-options]") {
+  // Ten poses turning 10 degrees each about z: a 29.9-degree step gives the
+  // ids 0, 3, 6, 9 (the sum reaches 30 degrees at every third pose).
+  posefuse::Trajectory t;
+  for (int k = 0; k < 10; ++k) t.push_back(k, yaw_z(k * 10.0 * std::numbers::pi / 180.0));
+  posefuse::RpeOptions o;
+  o.delta = 29.9;
+  o.delta_unit = posefuse::DeltaUnit::kDegrees;
+  CHECK(posefuse::rpe(t, t, o).pairs == Pairs{{0, 3}, {3, 6}, {6, 9}});
+  o.delta = 29.9 * std::numbers::pi / 180.0;
+  o.delta_unit = posefuse::DeltaUnit::kRadians;
+  CHECK(posefuse::rpe(t, t, o).pairs == Pairs{{0, 3}, {3, 6}, {6, 9}});
+  CHECK(posefuse::parse_delta_unit("d") == posefuse::DeltaUnit::kDegrees);
+  CHECK(posefuse::parse_delta_unit("rad") == posefuse::DeltaUnit::kRadians);
+}
+
+TEST_CASE("Metrics: scale-only alignment, n_to_align and origin alignment", "[eval][metrics][evo-options]") {
+  const posefuse::Trajectory ref = posefuse::test::make_vehicle_trajectory(60, 3, 50.0);
+  SECTION("scale only multiplies positions and leaves rotations") {
+    posefuse::Trajectory est = ref;
+    for (auto& T : est.poses) T.translation() *= 2.5;
+    const auto r = posefuse::ape(ref, est, PoseRelation::kTranslation, posefuse::Alignment::kScale);
+    CHECK(r.alignment.scale == Approx(0.4).epsilon(1e-12));
+    CHECK(r.alignment.rotation == Eigen::Matrix3d::Identity());
+    CHECK(r.alignment.translation == Eigen::Vector3d::Zero());
+    CHECK(r.stats.max < 1e-9);
+    // A rotated copy is not fixed by scale alone.
+    posefuse::Trajectory turned = est;
+    for (auto& T : turned.poses) T = yaw_z(0.3) * T;
+    CHECK(posefuse::ape(ref, turned, PoseRelation::kTranslation, posefuse::Alignment::kScale).stats.max > 1.0);
+  }
+  SECTION("n_to_align uses only the first poses") {
+    // The first 10 estimate poses are the reference moved by a known T; the
+    // rest drift. Aligning on the first 10 recovers T exactly.
+    const Eigen::Isometry3d T = yaw_z(0.7, {3, -2, 1});
+    posefuse::Trajectory est = ref;
+    for (std::size_t k = 0; k < est.size(); ++k) {
+      est.poses[k] = T.inverse() * ref.poses[k];
+      if (k >= 10) est.poses[k].translation() += Eigen::Vector3d(0.2 * double(k - 9), 0, 0);
+    }
+    posefuse::AlignmentOptions a;
+    a.alignment = posefuse::Alignment::kSE3;
+    a.n_to_align = 10;
+    const auto r = posefuse::ape(ref, est, PoseRelation::kTranslation, a);
+    CHECK(r.alignment.rotation.isApprox(T.linear(), 1e-12));
+    CHECK((r.alignment.translation - T.translation()).norm() < 1e-10);
+    for (std::size_t k = 0; k < 10; ++k) CHECK(r.errors[k] < 1e-10);
+    CHECK(r.errors.back() == Approx(0.2 * 50).epsilon(1e-9));
+    a.n_to_align = 61;
+    CHECK_THROWS_WITH(posefuse::ape(ref, est, PoseRelation::kTranslation, a),
+                      Catch::Contains("only 60 are associated"));
+  }
+  SECTION("origin alignment maps the first pose onto the reference's") {
+    const Eigen::Isometry3d T = yaw_z(-1.1, {10, 5, 0});
+    posefuse::Trajectory est = ref;
+    for (auto& P : est.poses) P = T * P;
+    posefuse::AlignmentOptions a;
+    a.align_origin = true;
+    const auto r = posefuse::ape(ref, est, PoseRelation::kTranslation, a);
+    CHECK(r.stats.max < 1e-9);  // a rigid copy: every pose lands on the reference
+    CHECK(r.alignment.rotation.isApprox(T.linear().transpose(), 1e-12));
+    a.alignment = posefuse::Alignment::kSE3;
+    CHECK_THROWS_WITH(posefuse::ape(ref, est, PoseRelation::kTranslation, a),
+                      Catch::Contains("exclude each other"));
+  }
+}
+
+TEST_CASE("Metrics: time range, down-sampling and the motion filter", "[eval][metrics][evo-options]") {
+  const posefuse::Trajectory t = line_along_x({0, 0.4, 0.8, 1.2, 1.6, 2.0, 2.4, 2.8, 3.2, 3.6});
+  const auto stamps = [](const posefuse::Trajectory& x) { return x.t_s; };
+  CHECK(stamps(posefuse::reduce_to_time_range(t, 2.5, 6.0)) == std::vector<double>{3, 4, 5, 6});
+  CHECK(stamps(posefuse::reduce_to_time_range(t, std::nullopt, 1.0)) == std::vector<double>{0, 1});
+  CHECK(stamps(posefuse::reduce_to_time_range(t, 8.0, std::nullopt)) == std::vector<double>{8, 9});
+  CHECK(posefuse::reduce_to_time_range(t, 20.0, std::nullopt).empty());
+  CHECK_THROWS_AS(posefuse::reduce_to_time_range(t, 3.0, 2.0), posefuse::invalid_argument);
+  // numpy.linspace(0, 9, m, dtype=int)
+  CHECK(stamps(posefuse::downsample(t, 4)) == std::vector<double>{0, 3, 6, 9});
+  CHECK(stamps(posefuse::downsample(t, 3)) == std::vector<double>{0, 4, 9});
+  CHECK(stamps(posefuse::downsample(t, 1)) == std::vector<double>{0});
+  CHECK(posefuse::downsample(t, 10).size() == 10);
+  CHECK_THROWS_AS(posefuse::downsample(t, 0), posefuse::invalid_argument);
+  // 0.4 m steps, 1 m threshold: kept at 1.2 m (pose 3), 2.4 m (6), 3.6 m (9).
+  CHECK(stamps(posefuse::motion_filter(t, 1.0, 10.0)) == std::vector<double>{0, 3, 6, 9});
+  // Turning in place 10 degrees a step, 25-degree threshold: 0, 3, 6, 9.
+  posefuse::Trajectory turn;
+  for (int k = 0; k < 10; ++k) turn.push_back(k, yaw_z(k * 10.0 * std::numbers::pi / 180.0));
+  CHECK(stamps(posefuse::motion_filter(turn, 1.0, 25.0 * std::numbers::pi / 180.0)) ==
+        std::vector<double>{0, 3, 6, 9});
+  CHECK_THROWS_AS(posefuse::motion_filter(t, -1.0, 1.0), posefuse::invalid_argument);
+}
+
+TEST_CASE("Metrics: projection to a plane keeps the angle about its normal", "[eval][metrics][evo-options]") {
+  // R = Rz(0.5) Ry(0.2) Rx(0.1) at (1, 2, 3).
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = (Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()) *
+                Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitY()) *
+                Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitX()))
+                   .toRotationMatrix();
+  T.translation() = Eigen::Vector3d(1, 2, 3);
+  posefuse::Trajectory t;
+  t.push_back(0.0, T);
+  const struct {
+    posefuse::Plane plane;
+    Eigen::Vector3d position;
+    Eigen::Vector3d axis;
+    double angle;
+  } cases[] = {{posefuse::Plane::kXY, {1, 2, 0}, Eigen::Vector3d::UnitZ(), 0.5},
+               {posefuse::Plane::kXZ, {1, 0, 3}, Eigen::Vector3d::UnitY(), 0.2},
+               {posefuse::Plane::kYZ, {0, 2, 3}, Eigen::Vector3d::UnitX(), 0.1}};
+  for (const auto& c : cases) {
+    const posefuse::Trajectory p = posefuse::project_poses_to_plane(t, c.plane);
+    CHECK(p.poses[0].translation() == c.position);
+    CHECK(p.poses[0].linear().isApprox(Eigen::AngleAxisd(c.angle, c.axis).toRotationMatrix(), 1e-14));
+  }
+  // In the metric: a height and tilt error vanish in the xy projection.
+  posefuse::Trajectory ref, est;
+  for (int k = 0; k < 5; ++k) {
+    ref.push_back(k, yaw_z(0.1 * k, {double(k), 0, 0}));
+    Eigen::Isometry3d P = ref.poses.back();
+    P.translation().z() += 0.5;
+    P.linear() = P.linear() * Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitX()).toRotationMatrix();
+    est.push_back(k, P);
+  }
+  posefuse::AlignmentOptions a;
+  CHECK(posefuse::ape(ref, est, PoseRelation::kTranslation, a).stats.max == Approx(0.5));
+  a.project_to_plane = posefuse::Plane::kXY;
+  CHECK(posefuse::ape(ref, est, PoseRelation::kTranslation, a).stats.max < 1e-15);
+  CHECK(posefuse::ape(ref, est, PoseRelation::kRotationAngleRad, a).stats.max < 1e-7);
 }

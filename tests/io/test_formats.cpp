@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <Eigen/Geometry>
+#include <Eigen/SVD>
 #include <cmath>
 #include <filesystem>
 #include <locale>
@@ -311,12 +312,13 @@ TEST_CASE("Formats: KITTI times.txt errors name the right file and line", "[io][
   SECTION("not increasing") {
     const auto times = dir.write("times.txt", "0.0\n0.1\n0.1\n");
     check_error(expect_io_error([&] { (void)posefuse::read_kitti(poses, times); }), times, 3,
-                "not greater than the previous one (0.1 on line 2)");
+                "timestamp 0.1 repeats the previous one (0.1 on line 2); repeated stamps can be "
+                "kept first or last instead (--duplicates)");
   }
   SECTION("decreasing, also via read_kitti_times") {
     const auto times = dir.write("times.txt", "0.0\n0.2\n0.1\n");
     check_error(expect_io_error([&] { (void)posefuse::read_kitti_times(times); }), times, 3,
-                "not greater");
+                "timestamp 0.1 is smaller than the previous one (0.2 on line 2)");
   }
   SECTION("two numbers on a line") {
     const auto times = dir.write("times.txt", "0.0\n0.1 0.2\n0.3\n");
@@ -355,8 +357,8 @@ TEST_CASE("Formats: TUM malformed lines report file:line and the reason", "[io][
       {"bad number", "0.2 1 0 0 0 0 0 one\n", "cannot parse 'one' in column 8"},
       {"nan stamp", "nan 1 0 0 0 0 0 1\n", "non-finite value 'nan' in column 1"},
       {"equal stamp", "0.1 1 0 0 0 0 0 1\n",
-       "timestamp 0.1 is not greater than the previous one (0.1 on line 3)"},
-      {"earlier stamp", "0.05 1 0 0 0 0 0 1\n", "not greater than the previous"},
+       "timestamp 0.1 repeats the previous one (0.1 on line 3)"},
+      {"earlier stamp", "0.05 1 0 0 0 0 0 1\n", "timestamp 0.05 is smaller than the previous one (0.1 on line 3)"},
       {"zero quaternion", "0.2 1 0 0 0 0 0 0\n", "quaternion has zero norm"},
       {"non-unit quaternion", "0.2 1 0 0 0 0 0 2\n", "quaternion norm 2 differs from 1"},
   };
@@ -414,4 +416,141 @@ TEST_CASE("Formats: real KITTI 06 files read with default tolerances", "[io][dat
   strict.rotation_tolerance = 1e-4;
   CHECK_THROWS_AS(posefuse::read_kitti(dir / "cvo_vo.txt", std::nullopt, strict),
                   posefuse::io_error);
+}
+
+// ---------------------------------------------------------------------------
+// Input policy (evaluation issue): repeated stamps, byte-order marks, cheap
+// re-orthonormalisation.
+
+TEST_CASE("Formats: TUM repeated stamps follow the duplicate policy and are reported",
+          "[io][tum][duplicates]") {
+  TempDir dir("tum-dup");
+  // Lines 3 and 4 repeat line 2's stamp with other positions (x = 2, 3).
+  const auto file = dir.write("d.tum",
+                              "# t x y z qx qy qz qw\n"
+                              "0.1 1 0 0 0 0 0 1\n"
+                              "0.1 2 0 0 0 0 0 1\n"
+                              "0.1 3 0 0 0 0 0 1\n"
+                              "0.2 4 0 0 0 0 0 1\n"
+                              "0.3 5 0 0 0 0 0 1\n"
+                              "0.3 6 0 0 0 0 0 1\n");
+  posefuse::ReadOptions options;
+  SECTION("error (the library default) names the first repeat") {
+    check_error(expect_io_error([&] { (void)posefuse::read_tum(file); }), file, 3,
+                "timestamp 0.1 repeats the previous one (0.1 on line 2)");
+  }
+  SECTION("first keeps the first pose of each run") {
+    options.duplicates = posefuse::DuplicateStamps::kFirst;
+    posefuse::ReadReport report;
+    const posefuse::Trajectory traj = posefuse::read_tum(file, options, &report);
+    REQUIRE(traj.size() == 3);
+    CHECK(traj.t_s == std::vector<double>{0.1, 0.2, 0.3});
+    CHECK(traj.poses[0].translation().x() == 1.0);
+    CHECK(traj.poses[1].translation().x() == 4.0);
+    CHECK(traj.poses[2].translation().x() == 5.0);
+    CHECK(report.duplicates_dropped == 3);
+    CHECK(report.first_duplicate_line == 3);
+  }
+  SECTION("last keeps the last pose of each run") {
+    options.duplicates = posefuse::DuplicateStamps::kLast;
+    posefuse::ReadReport report;
+    const posefuse::Trajectory traj = posefuse::read_tum(file, options, &report);
+    REQUIRE(traj.size() == 3);
+    CHECK(traj.poses[0].translation().x() == 3.0);
+    CHECK(traj.poses[1].translation().x() == 4.0);
+    CHECK(traj.poses[2].translation().x() == 6.0);
+    CHECK(report.duplicates_dropped == 3);
+  }
+  SECTION("a decreasing stamp stays an error under every policy") {
+    const auto bad = dir.write("b.tum", "0.1 1 0 0 0 0 0 1\n0.1 2 0 0 0 0 0 1\n0.05 3 0 0 0 0 0 1\n");
+    for (const auto policy : {posefuse::DuplicateStamps::kFirst, posefuse::DuplicateStamps::kLast}) {
+      options.duplicates = policy;
+      check_error(expect_io_error([&] { (void)posefuse::read_tum(bad, options); }), bad, 3,
+                  "timestamp 0.05 is smaller than the previous one (0.1 on line 2)");
+    }
+  }
+  SECTION("policy names parse and print") {
+    CHECK(posefuse::parse_duplicate_stamps("first") == posefuse::DuplicateStamps::kFirst);
+    CHECK(posefuse::parse_duplicate_stamps("last") == posefuse::DuplicateStamps::kLast);
+    CHECK(posefuse::parse_duplicate_stamps("error") == posefuse::DuplicateStamps::kError);
+    CHECK(posefuse::to_string(posefuse::DuplicateStamps::kLast) == "last");
+    CHECK_THROWS_AS(posefuse::parse_duplicate_stamps("keep"), posefuse::invalid_argument);
+  }
+}
+
+TEST_CASE("Formats: KITTI times with repeated stamps drop the matching poses",
+          "[io][kitti][duplicates]") {
+  TempDir dir("kitti-dup");
+  // Pose k has tx = k, so the kept poses can be identified.
+  std::string poses_text;
+  for (int k = 0; k < 5; ++k) poses_text += "1 0 0 " + std::to_string(k) + " 0 1 0 0 0 0 1 0\n";
+  const auto poses = dir.write("p.txt", poses_text);
+  const auto times = dir.write("t.txt", "0.0\n0.1\n0.1\n# note\n0.2\n0.2\n");
+  posefuse::ReadOptions options;
+  options.duplicates = posefuse::DuplicateStamps::kFirst;
+  posefuse::ReadReport report;
+  posefuse::Trajectory traj = posefuse::read_kitti(poses, times, options, &report);
+  REQUIRE(traj.size() == 3);
+  CHECK(traj.t_s == std::vector<double>{0.0, 0.1, 0.2});
+  CHECK(traj.poses[1].translation().x() == 1.0);
+  CHECK(traj.poses[2].translation().x() == 3.0);
+  CHECK(report.duplicates_dropped == 2);
+  CHECK(report.first_duplicate_line == 3);
+
+  options.duplicates = posefuse::DuplicateStamps::kLast;
+  traj = posefuse::read_kitti(poses, times, options);
+  REQUIRE(traj.size() == 3);
+  CHECK(traj.poses[1].translation().x() == 2.0);
+  CHECK(traj.poses[2].translation().x() == 4.0);
+
+  // Counts are compared line for line, before anything is dropped.
+  const auto short_times = dir.write("s.txt", "0.0\n0.1\n0.1\n0.2\n");
+  check_error(expect_io_error([&] { (void)posefuse::read_kitti(poses, short_times, options); }),
+              poses, 5, "pose file has 5 poses but");
+}
+
+TEST_CASE("Formats: a UTF-8 byte-order mark does not break the first number", "[io][bom]") {
+  TempDir dir("bom");
+  const std::string bom = "\xEF\xBB\xBF";
+  const auto tum = dir.write("b.tum", bom + "0.5 1 2 3 0 0 0 1\n0.6 1 2 3 0 0 0 1\n");
+  const posefuse::Trajectory t = posefuse::read_tum(tum);
+  REQUIRE(t.size() == 2);
+  CHECK(t.t_s[0] == 0.5);
+  const auto tum_comment = dir.write("c.tum", bom + "# header\n0.5 1 2 3 0 0 0 1\n");
+  CHECK(posefuse::read_tum(tum_comment).size() == 1);
+  const auto kitti = dir.write("b.txt", bom + kIdentityRow);
+  CHECK(posefuse::read_kitti(kitti).size() == 1);
+  const auto times = dir.write("t.txt", bom + "1.25\n");
+  CHECK(posefuse::read_kitti_times(times) == std::vector<double>{1.25});
+  // Only at the start of the file: elsewhere it is a bad number.
+  const auto middle = dir.write("m.tum", "0.5 1 2 3 0 0 0 1\n" + bom + "0.6 1 2 3 0 0 0 1\n");
+  check_error(expect_io_error([&] { (void)posefuse::read_tum(middle); }), middle, 2,
+              "cannot parse");
+}
+
+TEST_CASE("Formats: the polar re-orthonormalisation equals the SVD's nearest rotation",
+          "[io][kitti]") {
+  std::mt19937_64 rng(20261202);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  std::uniform_real_distribution<double> size(-9.0, -3.0);
+  for (int trial = 0; trial < 300; ++trial) {
+    const Eigen::Vector3d axis_angle(n01(rng), n01(rng), n01(rng));
+    const Eigen::Matrix3d R0 =
+        Eigen::AngleAxisd(axis_angle.norm(), axis_angle.normalized()).toRotationMatrix();
+    Eigen::Matrix3d noise;
+    for (int i = 0; i < 9; ++i) noise(i / 3, i % 3) = n01(rng);
+    const Eigen::Matrix3d R = R0 + std::pow(10.0, size(rng)) * noise;
+    const double residual = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+    if (!(residual <= 1e-3) || residual <= posefuse::detail::traj_io::kExactlyOrthonormal) continue;
+    const Eigen::Matrix3d polar = posefuse::detail::traj_io::checked_rotation(R, 1e-3, "x", 1);
+    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(R, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    const Eigen::Matrix3d nearest = svd.matrixU() * svd.matrixV().transpose();
+    INFO("trial " << trial << ", residual " << residual);
+    // Both are the same matrix up to each algorithm's rounding (the SVD's
+    // own product is orthonormal only to about 3e-15); Newton's result is
+    // orthonormal to about one ulp.
+    CHECK((polar - nearest).cwiseAbs().maxCoeff() < 4e-15);
+    CHECK((polar.transpose() * polar - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-15);
+    CHECK(polar.determinant() > 0.0);
+  }
 }

@@ -25,17 +25,19 @@ enum class Alignment {
   kNone,  ///< compare as is
   kSE3,   ///< rotation + translation (evo `--align`)
   kSim3,  ///< rotation + translation + scale (evo `--align --correct_scale`), for monocular SLAM
+  kScale,  ///< scale only: positions multiplied by Umeyama's scale (evo `--correct_scale` alone)
 };
 
-/// Parses "none", "se3" or "sim3".
+/// Parses "none", "se3", "sim3" or "scale".
 /// @throws posefuse::invalid_argument for any other text
 template <class Lazy = void>
 [[nodiscard]] Alignment parse_alignment(std::string_view name) {
   if (name == "none") return Alignment::kNone;
   if (name == "se3") return Alignment::kSE3;
   if (name == "sim3") return Alignment::kSim3;
+  if (name == "scale") return Alignment::kScale;
   throw invalid_argument("unknown alignment '" + std::string(name) +
-                         "' (expected none, se3 or sim3)");
+                         "' (expected none, se3, sim3 or scale)");
 }
 
 /// The name `parse_alignment` accepts for `alignment`.
@@ -44,6 +46,7 @@ template <class Lazy = void>
     case Alignment::kNone: return "none";
     case Alignment::kSE3: return "se3";
     case Alignment::kSim3: return "sim3";
+    case Alignment::kScale: return "scale";
   }
   return "?";
 }
@@ -158,27 +161,45 @@ struct AlignedTrajectory {
   AlignmentResult transform;  ///< \f$ (R, t, c) \f$ used
 };
 
-/// Aligns `est` to `ref` over all their (already associated) positions, as
-/// evo's `align_trajectory(est, ref, correct_scale)`.
+/// Aligns `est` to `ref` over their (already associated) positions, as
+/// evo's `align_trajectory(est, ref, correct_scale, correct_only_scale, n)`.
 /// @param[in] est estimate, pose k registered to `ref` pose k
 /// @param[in] ref reference
-/// @param[in] alignment kNone (returns `est` and the identity), kSE3 or kSim3
-/// @return the aligned estimate and the similarity
-/// @throws posefuse::invalid_argument for different sizes or the
-///         degenerate cases of `umeyama_alignment`
+/// @param[in] alignment kNone (returns `est` and the identity), kSE3, kSim3,
+///            or kScale (Umeyama's Sim(3) scale applied to the positions
+///            alone, rotation and translation left as they are)
+/// @param[in] n_to_align use only the first `n_to_align` pose pairs to
+///            compute the alignment (evo `--n_to_align`); 0 means all
+/// @return the aligned estimate (every pose moved) and the similarity
+/// @throws posefuse::invalid_argument for different sizes, `n_to_align`
+///         larger than the poses, or the degenerate cases of `umeyama_alignment`
 template <class Lazy = void>
 [[nodiscard]] AlignedTrajectory align_trajectory(const Trajectory& est,
                                                  const Trajectory& ref,
-                                                 Alignment alignment) {
+                                                 Alignment alignment,
+                                                 std::size_t n_to_align = 0) {
   if (est.size() != ref.size()) {
     throw invalid_argument("align_trajectory: estimate has " + std::to_string(est.size()) +
                            " poses but reference has " + std::to_string(ref.size()) +
-                           " (associate them first)");
+                           " (call associate() first)");
+  }
+  if (n_to_align > est.size()) {
+    throw invalid_argument("align_trajectory: " + std::to_string(n_to_align) +
+                           " poses to align requested but only " + std::to_string(est.size()) +
+                           " are associated");
   }
   if (alignment == Alignment::kNone) return {est, AlignmentResult{}};
-  const std::vector<Eigen::Vector3d> x = est.positions();
-  const std::vector<Eigen::Vector3d> y = ref.positions();
-  const AlignmentResult a = umeyama_alignment(x, y, alignment == Alignment::kSim3);
+  std::vector<Eigen::Vector3d> x = est.positions();
+  std::vector<Eigen::Vector3d> y = ref.positions();
+  if (n_to_align > 0) {
+    x.resize(n_to_align);
+    y.resize(n_to_align);
+  }
+  AlignmentResult a = umeyama_alignment(x, y, alignment != Alignment::kSE3);
+  if (alignment == Alignment::kScale) {
+    a.rotation = Eigen::Matrix3d::Identity();
+    a.translation = Eigen::Vector3d::Zero();
+  }
   return {apply_alignment(est, a), a};
 }
 

@@ -7,10 +7,12 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstddef>
 #include <numbers>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -20,6 +22,8 @@
 #include <posefuse/core/error.hpp>
 #include <posefuse/eval/alignment.hpp>
 #include <posefuse/eval/statistics.hpp>
+#include <posefuse/eval/trajectory_filters.hpp>
+#include <posefuse/core/plane.hpp>
 #include <posefuse/core/trajectory.hpp>
 
 namespace posefuse {
@@ -50,9 +54,19 @@ enum class PoseRelation {
   kRotationAngleDeg,  ///< rotation angle of \f$ R(E) \f$ (deg), evo `angle_deg`
   kRotationAngleRad,  ///< rotation angle of \f$ R(E) \f$ (rad), evo `angle_rad`
   kFull,              ///< \f$ \lVert E - I_4 \rVert_F \f$ (unit-less), evo `full`
+  kRotationPart,      ///< \f$ \lVert R(E) - I_3 \rVert_F \f$ (unit-less), evo `rot_part`
+  /// APE: \f$ \lVert p_k - q_k \rVert \f$ (as kTranslation); RPE:
+  /// \f$ |\,\lVert p_j - p_i \rVert - \lVert q_j - q_i \rVert\,| \f$,
+  /// distances only, no orientation (m), evo `point_distance`
+  kPointDistance,
+  /// RPE only: the point-distance error in percent of the reference
+  /// distance \f$ \lVert q_j - q_i \rVert \f$ (pairs whose reference
+  /// distance is 0 are left out) (%), evo `point_distance_error_ratio`
+  kPointDistanceErrorRatio,
 };
 
-/// Parses "trans" (or "trans_part"), "angle_deg", "angle_rad" or "full".
+/// Parses "trans" (or "trans_part"), "angle_deg", "angle_rad", "full",
+/// "rot_part", "point_distance" or "point_distance_error_ratio".
 /// @throws posefuse::invalid_argument for any other text
 template <class Lazy = void>
 [[nodiscard]] PoseRelation parse_pose_relation(std::string_view name) {
@@ -60,17 +74,38 @@ template <class Lazy = void>
   if (name == "angle_deg") return PoseRelation::kRotationAngleDeg;
   if (name == "angle_rad") return PoseRelation::kRotationAngleRad;
   if (name == "full") return PoseRelation::kFull;
+  if (name == "rot_part") return PoseRelation::kRotationPart;
+  if (name == "point_distance") return PoseRelation::kPointDistance;
+  if (name == "point_distance_error_ratio") return PoseRelation::kPointDistanceErrorRatio;
   throw invalid_argument("unknown pose relation '" + std::string(name) +
-                         "' (expected trans, angle_deg, angle_rad or full)");
+                         "' (expected trans, angle_deg, angle_rad, full, rot_part, "
+                         "point_distance or point_distance_error_ratio)");
 }
 
-/// Unit of the errors of a pose relation: "m", "deg", "rad" or "" (unit-less).
+/// The evo name of a pose relation ("trans_part", "angle_deg", ...).
+[[nodiscard]] constexpr std::string_view to_string(PoseRelation relation) noexcept {
+  switch (relation) {
+    case PoseRelation::kTranslation: return "trans_part";
+    case PoseRelation::kRotationAngleDeg: return "angle_deg";
+    case PoseRelation::kRotationAngleRad: return "angle_rad";
+    case PoseRelation::kFull: return "full";
+    case PoseRelation::kRotationPart: return "rot_part";
+    case PoseRelation::kPointDistance: return "point_distance";
+    case PoseRelation::kPointDistanceErrorRatio: return "point_distance_error_ratio";
+  }
+  return "?";
+}
+
+/// Unit of the errors of a pose relation: "m", "deg", "rad", "%" or "" (unit-less).
 [[nodiscard]] constexpr std::string_view unit_of(PoseRelation relation) noexcept {
   switch (relation) {
     case PoseRelation::kTranslation: return "m";
+    case PoseRelation::kPointDistance: return "m";
     case PoseRelation::kRotationAngleDeg: return "deg";
     case PoseRelation::kRotationAngleRad: return "rad";
+    case PoseRelation::kPointDistanceErrorRatio: return "%";
     case PoseRelation::kFull: return "";
+    case PoseRelation::kRotationPart: return "";
   }
   return "";
 }
@@ -87,7 +122,9 @@ template <class Lazy = void>
   return std::atan2(0.5 * v.norm(), 0.5 * (R.trace() - 1.0));
 }
 
-/// The error of an error pose \f$ E \f$ under a pose relation (see PoseRelation).
+/// The error of an error pose \f$ E \f$ under a pose relation (see
+/// PoseRelation; the point-distance relations, which compare distances
+/// rather than poses, give \f$ \lVert t(E) \rVert \f$ here).
 template <class Lazy = void>
 [[nodiscard]] double pose_error(const Eigen::Isometry3d& E, PoseRelation relation) noexcept {
   switch (relation) {
@@ -95,6 +132,9 @@ template <class Lazy = void>
     case PoseRelation::kRotationAngleDeg:
       return rotation_angle(E.linear()) * 180.0 / std::numbers::pi;
     case PoseRelation::kRotationAngleRad: return rotation_angle(E.linear());
+    case PoseRelation::kRotationPart: return (E.linear() - Eigen::Matrix3d::Identity()).norm();
+    case PoseRelation::kPointDistance:
+    case PoseRelation::kPointDistanceErrorRatio: return E.translation().norm();
     case PoseRelation::kFull: break;
   }
   return (E.matrix() - Eigen::Matrix4d::Identity()).norm();
@@ -109,38 +149,78 @@ struct MetricResult {
   std::vector<std::pair<std::size_t, std::size_t>> pairs;
 };
 
+/// How the estimate is brought onto the reference before a metric, in
+/// evo's order: Umeyama alignment (over the first `n_to_align` pairs) or
+/// origin alignment, then projection onto a plane.
+struct AlignmentOptions {
+  Alignment alignment = Alignment::kNone;  ///< `--align` / `--correct_scale`
+  std::size_t n_to_align = 0;              ///< `--n_to_align`: first N pairs only; 0 = all
+  bool align_origin = false;               ///< `--align_origin` (excludes `alignment`)
+  std::optional<Plane> project_to_plane;   ///< `--project_to_plane`, after alignment
+};
+
+namespace detail {
+
+/// Aligns and projects as `options` says (see AlignmentOptions); the
+/// reference is projected too.
+/// @throws posefuse::invalid_argument for Umeyama and origin alignment together
+template <class Lazy = void>
+std::pair<AlignedTrajectory, Trajectory> prepare_for_metric(const Trajectory& ref,
+                                                            const Trajectory& est,
+                                                            const AlignmentOptions& options) {
+  if (options.align_origin && options.alignment != Alignment::kNone)
+    throw invalid_argument("alignment: Umeyama alignment and origin alignment exclude each other");
+  AlignedTrajectory aligned = options.align_origin
+                                  ? align_origin(est, ref)
+                                  : align_trajectory(est, ref, options.alignment, options.n_to_align);
+  if (!options.project_to_plane) return {std::move(aligned), ref};
+  aligned.trajectory = project_poses_to_plane(aligned.trajectory, *options.project_to_plane);
+  return {std::move(aligned), project_poses_to_plane(ref, *options.project_to_plane)};
+}
+
+template <class Lazy = void>
+void check_same_size(const Trajectory& ref, const Trajectory& est, const char* metric) {
+  if (ref.size() != est.size() || ref.empty()) {
+    throw invalid_argument(std::string(metric) + ": reference has " + std::to_string(ref.size()) +
+                           " poses and estimate " + std::to_string(est.size()) +
+                           " (need the same, non-zero number: call associate() first)");
+  }
+}
+
+}  // namespace detail
+
 /// Absolute pose error, as `evo_ape`: per pose k, the error pose
 /// \f$ E_k = P_k^{-1} Q_k \f$ (P estimate, Q reference; evo's `ape_base`),
-/// measured by `relation`; for kTranslation \f$ \lVert t(P_k) - t(Q_k) \rVert \f$.
+/// measured by `relation`; for kTranslation and kPointDistance
+/// \f$ \lVert t(P_k) - t(Q_k) \rVert \f$.
 ///
 /// Equivalences (ref and est already associated, e.g. by `associate`):
-/// `ape(ref, est, kTranslation, kSE3)` = `evo_ape kitti REF EST -a`;
-/// `ape(ref, est, kTranslation, kSim3)` = `evo_ape tum REF EST -as`;
-/// `ape(ref, est, kRotationAngleDeg)` = `evo_ape ... -r angle_deg`.
+/// `ape(ref, est, kTranslation, {kSE3})` = `evo_ape kitti REF EST -a`;
+/// `ape(ref, est, kTranslation, {kSim3})` = `evo_ape tum REF EST -as`;
+/// `{kScale}` = `-s` alone; `{kSE3, 100}` = `-a --n_to_align 100`;
+/// `{.align_origin = true}` = `--align_origin`.
 /// @param[in] ref reference trajectory
 /// @param[in] est estimated trajectory, pose k registered to `ref` pose k
-/// @param[in] relation the measured part of the error pose
-/// @param[in] alignment alignment of `est` to `ref` over all poses, applied first
+/// @param[in] relation the measured part of the error pose (not kPointDistanceErrorRatio)
+/// @param[in] alignment alignment and projection, applied first
 /// @return errors, statistics and the similarity used
-/// @throws posefuse::invalid_argument for different or zero sizes, or a
-///         degenerate alignment
+/// @throws posefuse::invalid_argument for different or zero sizes, a
+///         degenerate alignment, conflicting alignments, or an RPE-only relation
 template <class Lazy = void>
 [[nodiscard]] MetricResult ape(const Trajectory& ref, const Trajectory& est,
-                               PoseRelation relation = PoseRelation::kTranslation,
-                               Alignment alignment = Alignment::kNone) {
-  if (ref.size() != est.size() || ref.empty()) {
-    throw invalid_argument("ape: reference has " + std::to_string(ref.size()) +
-                           " poses and estimate " + std::to_string(est.size()) +
-                           " (need the same, non-zero number; associate them first)");
-  }
-  const AlignedTrajectory aligned = align_trajectory(est, ref, alignment);
+                               PoseRelation relation, const AlignmentOptions& alignment) {
+  detail::check_same_size(ref, est, "ape");
+  if (relation == PoseRelation::kPointDistanceErrorRatio)
+    throw invalid_argument("ape: point_distance_error_ratio is a relative (RPE) measure");
+  const auto [aligned, ref_used] = detail::prepare_for_metric(ref, est, alignment);
   MetricResult r;
   r.alignment = aligned.transform;
   r.errors.reserve(ref.size());
   for (std::size_t k = 0; k < ref.size(); ++k) {
     const Eigen::Isometry3d& P = aligned.trajectory.poses[k];
-    const Eigen::Isometry3d& Q = ref.poses[k];
-    r.errors.push_back(relation == PoseRelation::kTranslation
+    const Eigen::Isometry3d& Q = ref_used.poses[k];
+    r.errors.push_back(relation == PoseRelation::kTranslation ||
+                               relation == PoseRelation::kPointDistance
                            ? (P.translation() - Q.translation()).norm()
                            : pose_error(P.inverse() * Q, relation));
   }
@@ -148,35 +228,136 @@ template <class Lazy = void>
   return r;
 }
 
-/// Unit of the RPE step `delta` (evo `--delta_unit f|m`).
+/// APE with only an Umeyama alignment over all poses (see the overload above).
+template <class Lazy = void>
+[[nodiscard]] MetricResult ape(const Trajectory& ref, const Trajectory& est,
+                               PoseRelation relation = PoseRelation::kTranslation,
+                               Alignment alignment = Alignment::kNone) {
+  AlignmentOptions options;
+  options.alignment = alignment;
+  return ape(ref, est, relation, options);
+}
+
+/// Unit of the RPE step `delta` (evo `--delta_unit f|m|d|r`).
 enum class DeltaUnit {
-  kFrames,  ///< pose index steps (evo `f`)
-  kMeters,  ///< travelled path length (evo `m`)
+  kFrames,   ///< pose index steps (evo `f`)
+  kMeters,   ///< travelled path length (evo `m`)
+  kDegrees,  ///< accumulated rotation angle (evo `d`)
+  kRadians,  ///< accumulated rotation angle (evo `r`)
 };
 
-/// Parses "frames" (or "f") and "m" (or "meters").
+/// Parses "frames" (or "f"), "m" (or "meters"), "deg" (or "d") and "rad" (or "r").
 /// @throws posefuse::invalid_argument for any other text
 template <class Lazy = void>
 [[nodiscard]] DeltaUnit parse_delta_unit(std::string_view name) {
   if (name == "frames" || name == "f") return DeltaUnit::kFrames;
   if (name == "m" || name == "meters") return DeltaUnit::kMeters;
-  throw invalid_argument("unknown delta unit '" + std::string(name) + "' (expected frames or m)");
+  if (name == "deg" || name == "d") return DeltaUnit::kDegrees;
+  if (name == "rad" || name == "r") return DeltaUnit::kRadians;
+  throw invalid_argument("unknown delta unit '" + std::string(name) +
+                         "' (expected frames, m, deg or rad)");
 }
 
-/// Consecutive RPE pairs by index, evo's `filter_pairs_by_index(all_pairs=False)`:
-/// ids \f$ 0, \delta, 2\delta, \dots < n \f$ and the pairs of neighbouring ids.
+/// The short name of a delta unit ("frames", "m", "deg", "rad").
+[[nodiscard]] constexpr std::string_view to_string(DeltaUnit unit) noexcept {
+  switch (unit) {
+    case DeltaUnit::kFrames: return "frames";
+    case DeltaUnit::kMeters: return "m";
+    case DeltaUnit::kDegrees: return "deg";
+    case DeltaUnit::kRadians: return "rad";
+  }
+  return "?";
+}
+
+/// RPE pairs by index, evo's `filter_pairs_by_index`: consecutive pairs
+/// \f$ (k\delta, (k+1)\delta) \f$, or with `all_pairs` every
+/// \f$ (i, i+\delta) \f$.
 /// @param[in] n number of poses
 /// @param[in] delta index step (>= 1)
-/// @return pairs \f$ (k\delta, (k+1)\delta) \f$
+/// @param[in] all_pairs every start index instead of every delta-th
+/// @return the pairs
 /// @throws posefuse::invalid_argument when `delta` is 0
 template <class Lazy = void>
 [[nodiscard]] std::vector<std::pair<std::size_t, std::size_t>> rpe_pairs_by_index(
-    std::size_t n, std::size_t delta) {
+    std::size_t n, std::size_t delta, bool all_pairs = false) {
   if (delta == 0) throw invalid_argument("rpe: delta in frames must be at least 1");
   std::vector<std::pair<std::size_t, std::size_t>> pairs;
-  for (std::size_t i = 0; i < n && delta < n - i; i += delta) pairs.emplace_back(i, i + delta);
+  const std::size_t stride = all_pairs ? 1 : delta;
+  for (std::size_t i = 0; i < n && delta < n - i; i += stride) pairs.emplace_back(i, i + delta);
   return pairs;
 }
+
+namespace detail {
+
+/// Consecutive pairs from a per-step increment (path length or rotation
+/// angle between pose k-1 and k): walking from index 0 the increments are
+/// summed, and every index where the sum reaches \f$ \ge \delta \f$ becomes
+/// an id and restarts the sum; pairs are neighbouring ids. `first_is_id`
+/// makes index 0 an id as well.
+template <class Lazy = void>
+std::vector<std::pair<std::size_t, std::size_t>> consecutive_pairs(std::span<const double> step,
+                                                                   double delta, bool first_is_id) {
+  std::vector<std::size_t> ids;
+  if (first_is_id && !step.empty()) ids.push_back(0);
+  double sum = 0.0;
+  for (std::size_t k = 0; k < step.size(); ++k) {
+    sum += step[k];
+    if (sum >= delta) {
+      if (ids.empty() || ids.back() != k) ids.push_back(k);
+      sum = 0.0;
+    }
+  }
+  std::vector<std::pair<std::size_t, std::size_t>> pairs;
+  for (std::size_t k = 1; k < ids.size(); ++k) pairs.emplace_back(ids[k - 1], ids[k]);
+  return pairs;
+}
+
+/// All pairs (i, j), j > i, whose cumulative quantity difference
+/// \f$ c_j - c_i \f$ is closest to \f$ \delta \f$ for each i (the first j
+/// on a tie) and within \f$ \delta \pm tol \f$ (evo's all-pairs search
+/// on a non-decreasing cumulative path).
+template <class Lazy = void>
+std::vector<std::pair<std::size_t, std::size_t>> all_pairs_by_cumulative(
+    std::span<const double> cumulative, double delta, double tol) {
+  std::vector<std::pair<std::size_t, std::size_t>> pairs;
+  for (std::size_t i = 0; i < cumulative.size(); ++i) {
+    const double target = cumulative[i] + delta;
+    const auto first = cumulative.begin() + static_cast<std::ptrdiff_t>(i) + 1;
+    const auto lb = std::lower_bound(first, cumulative.end(), target);
+    std::size_t best = cumulative.size();
+    double best_diff = 0.0;
+    if (lb != first) {
+      const double d = std::abs(*(lb - 1) - target);
+      // the first index reaching the same value (a flat stretch of the path)
+      const auto same = std::lower_bound(first, lb, *(lb - 1));
+      best = static_cast<std::size_t>(same - cumulative.begin());
+      best_diff = d;
+    }
+    if (lb != cumulative.end()) {
+      const double d = std::abs(*lb - target);
+      if (best == cumulative.size() || d < best_diff) {
+        best = static_cast<std::size_t>(lb - cumulative.begin());
+        best_diff = d;
+      }
+    }
+    if (best < cumulative.size() && best_diff <= tol) pairs.emplace_back(i, best);
+  }
+  return pairs;
+}
+
+/// Per-step increments between consecutive poses: path length (m) or
+/// rotation angle (rad) of \f$ T_{k-1}^{-1} T_k \f$; element 0 is 0.
+template <class Lazy = void>
+std::vector<double> pose_steps(std::span<const Eigen::Isometry3d> poses, bool angles) {
+  std::vector<double> step(poses.size(), 0.0);
+  for (std::size_t k = 1; k < poses.size(); ++k) {
+    step[k] = angles ? rotation_angle(poses[k - 1].linear().transpose() * poses[k].linear())
+                     : (poses[k].translation() - poses[k - 1].translation()).norm();
+  }
+  return step;
+}
+
+}  // namespace detail
 
 /// Consecutive RPE pairs by travelled path, evo's
 /// `filter_pairs_by_path(all_pairs=False)`: walking the poses from index 0,
@@ -195,37 +376,44 @@ template <class Lazy = void>
   if (!(delta_m > 0.0) || !std::isfinite(delta_m)) {
     throw invalid_argument("rpe: delta in metres must be positive and finite");
   }
-  std::vector<std::size_t> ids;
-  double path = 0.0;
-  for (std::size_t k = 0; k < poses.size(); ++k) {
-    if (k > 0) path += (poses[k].translation() - poses[k - 1].translation()).norm();
-    if (path >= delta_m) {
-      ids.push_back(k);
-      path = 0.0;
-    }
-  }
-  std::vector<std::pair<std::size_t, std::size_t>> pairs;
-  for (std::size_t k = 1; k < ids.size(); ++k) pairs.emplace_back(ids[k - 1], ids[k]);
-  return pairs;
+  return detail::consecutive_pairs(detail::pose_steps(poses, false), delta_m, false);
 }
 
 /// Options of `rpe` (evo_rpe's command-line options of the same meaning).
 struct RpeOptions {
   PoseRelation relation = PoseRelation::kTranslation;  ///< `--pose_relation`
-  double delta = 1.0;                         ///< `--delta`: frames (integer >= 1) or metres (> 0)
+  /// `--delta`: frames (integer >= 1), metres, degrees or radians (> 0)
+  double delta = 1.0;
   DeltaUnit delta_unit = DeltaUnit::kFrames;  ///< `--delta_unit`
   Alignment alignment = Alignment::kNone;     ///< `--align` / `--correct_scale`
   /// `--pairs_from_reference`: pick the path pairs on the reference instead
   /// of the (aligned) estimate. evo's default, and ours, is the estimate.
   bool pairs_from_reference = false;
+  /// `--all_pairs`: every start pose instead of consecutive pairs. With a
+  /// delta in metres or angle, pose i pairs with the j whose accumulated
+  /// path (angle) from i is closest to delta, kept when within
+  /// `delta * delta_tol` of it.
+  bool all_pairs = false;
+  double delta_tol = 0.1;       ///< `--delta_tol`: relative tolerance of all-pairs mode
+  std::size_t n_to_align = 0;   ///< `--n_to_align` (0 = all)
+  bool align_origin = false;    ///< `--align_origin`
+  std::optional<Plane> project_to_plane;  ///< `--project_to_plane`
 };
 
-/// Relative pose error over consecutive pairs, as `evo_rpe` (all_pairs off):
+/// Relative pose error, as `evo_rpe`:
 /// per pair (i, j), \f$ E = (Q_i^{-1} Q_j)^{-1} (P_i^{-1} P_j) \f$
 /// (Sturm et al., IROS 2012, eq. 1; P estimate, Q reference), measured by
-/// `options.relation`. The estimate is aligned first (SE(3) leaves the RPE
-/// unchanged; Sim(3) rescales it), then the pairs are chosen on the aligned
-/// estimate (or the reference) by index or by path length.
+/// `options.relation` (for the point-distance relations,
+/// \f$ |\,\lVert p_j - p_i \rVert - \lVert q_j - q_i \rVert\,| \f$ and its
+/// ratio to \f$ \lVert q_j - q_i \rVert \f$ in %). The estimate is aligned
+/// first (SE(3) leaves the RPE unchanged; Sim(3) rescales it) and projected
+/// if asked, then the pairs are chosen on the aligned estimate (or the
+/// reference) by index, path length or rotation angle.
+///
+/// Angle units (`kDegrees`, `kRadians`): consecutive ids start at pose 0 and
+/// follow whenever the summed rotation angles between consecutive poses
+/// reach delta. (evo sums differences of rotation-vector norms, which are
+/// not rotation angles; the pairs can differ from evo's for this unit.)
 ///
 /// Equivalence: `rpe(ref, est, {kTranslation, 10, kFrames})` =
 /// `evo_rpe kitti REF EST --delta 10 --delta_unit f`; with
@@ -236,22 +424,24 @@ struct RpeOptions {
 /// @param[in] options relation, delta, unit, alignment, pair source
 /// @return per-pair errors, statistics, the similarity and the pairs
 /// @throws posefuse::invalid_argument for different or zero sizes, a bad
-///         delta (non-integer frames, non-positive), a degenerate alignment,
-///         or when no pair exists for the delta (as evo; also for any delta
-///         in frames of at least the number of poses, however large)
+///         delta (non-integer frames, non-positive), a bad tolerance, a
+///         degenerate alignment, or when no pair exists for the delta (as
+///         evo; also for any delta in frames of at least the number of
+///         poses, however large)
 template <class Lazy = void>
 [[nodiscard]] MetricResult rpe(const Trajectory& ref, const Trajectory& est,
                                const RpeOptions& options = {}) {
-  if (ref.size() != est.size() || ref.empty()) {
-    throw invalid_argument("rpe: reference has " + std::to_string(ref.size()) +
-                           " poses and estimate " + std::to_string(est.size()) +
-                           " (need the same, non-zero number; associate them first)");
-  }
-  const AlignedTrajectory aligned = align_trajectory(est, ref, options.alignment);
+  detail::check_same_size(ref, est, "rpe");
+  const auto [aligned, ref_used] = detail::prepare_for_metric(
+      ref, est,
+      AlignmentOptions{options.alignment, options.n_to_align, options.align_origin,
+                       options.project_to_plane});
   const std::vector<Eigen::Isometry3d>& P = aligned.trajectory.poses;
-  const std::vector<Eigen::Isometry3d>& Q = ref.poses;
+  const std::vector<Eigen::Isometry3d>& Q = ref_used.poses;
   MetricResult r;
   r.alignment = aligned.transform;
+  if (!(options.delta_tol >= 0.0) || !std::isfinite(options.delta_tol))
+    throw invalid_argument("rpe: delta tolerance must be finite and >= 0");
   if (options.delta_unit == DeltaUnit::kFrames) {
     if (!(options.delta >= 1.0) || options.delta != std::floor(options.delta) ||
         !std::isfinite(options.delta)) {
@@ -260,23 +450,57 @@ template <class Lazy = void>
     // A step of n poses or more has no pair; checked in double, because a
     // huge delta (1e300, 2^64) does not fit in a size_t (the cast would be UB).
     if (options.delta < static_cast<double>(P.size())) {
-      r.pairs = rpe_pairs_by_index(P.size(), static_cast<std::size_t>(options.delta));
+      r.pairs = rpe_pairs_by_index(P.size(), static_cast<std::size_t>(options.delta),
+                                   options.all_pairs);
     }
   } else {
-    r.pairs = rpe_pairs_by_path(options.pairs_from_reference ? Q : P, options.delta);
+    if (!(options.delta > 0.0) || !std::isfinite(options.delta))
+      throw invalid_argument("rpe: delta must be positive and finite");
+    const bool angles = options.delta_unit != DeltaUnit::kMeters;
+    const double delta = options.delta_unit == DeltaUnit::kDegrees
+                             ? options.delta * std::numbers::pi / 180.0
+                             : options.delta;
+    const std::vector<double> step =
+        detail::pose_steps(options.pairs_from_reference ? Q : P, angles);
+    if (options.all_pairs) {
+      std::vector<double> cumulative(step.size(), 0.0);
+      for (std::size_t k = 1; k < step.size(); ++k) cumulative[k] = cumulative[k - 1] + step[k];
+      r.pairs = detail::all_pairs_by_cumulative(cumulative, delta, delta * options.delta_tol);
+    } else {
+      r.pairs = detail::consecutive_pairs(step, delta, angles);
+    }
   }
   if (r.pairs.empty()) {
     char delta[32];  // shortest round-trip text, locale-free; 24 chars suffice for a double
     const auto printed = std::to_chars(delta, delta + sizeof(delta), options.delta);
-    throw invalid_argument("rpe: delta = " + std::string(delta, printed.ptr) +
-                           (options.delta_unit == DeltaUnit::kFrames ? " (frames)" : " (m)") +
-                           " produced an empty index list - try lower values");
+    throw invalid_argument("rpe: delta = " + std::string(delta, printed.ptr) + " (" +
+                           std::string(to_string(options.delta_unit)) +
+                           ") produced an empty index list - try lower values" +
+                           (options.all_pairs ? " or a larger --delta-tol" : ""));
   }
   r.errors.reserve(r.pairs.size());
+  std::vector<std::pair<std::size_t, std::size_t>> kept;
   for (const auto& [i, j] : r.pairs) {
+    if (options.relation == PoseRelation::kPointDistance ||
+        options.relation == PoseRelation::kPointDistanceErrorRatio) {
+      const double d_ref = (Q[j].translation() - Q[i].translation()).norm();
+      const double d_est = (P[j].translation() - P[i].translation()).norm();
+      if (options.relation == PoseRelation::kPointDistance) {
+        r.errors.push_back(std::abs(d_ref - d_est));
+      } else if (d_ref != 0.0) {  // a zero reference distance has no ratio (evo skips it too)
+        r.errors.push_back(100.0 * std::abs(d_ref - d_est) / d_ref);
+        kept.push_back({i, j});
+      }
+      continue;
+    }
     const Eigen::Isometry3d Q_rel = Q[i].inverse() * Q[j];
     const Eigen::Isometry3d P_rel = P[i].inverse() * P[j];
     r.errors.push_back(pose_error(Q_rel.inverse() * P_rel, options.relation));
+  }
+  if (options.relation == PoseRelation::kPointDistanceErrorRatio) {
+    r.pairs = std::move(kept);
+    if (r.pairs.empty())
+      throw invalid_argument("rpe: every pair has a zero reference distance, no ratio exists");
   }
   r.stats = compute_statistics(r.errors);
   return r;

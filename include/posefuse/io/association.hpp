@@ -90,6 +90,40 @@ void check_stamps(std::span<const double> stamps, const char* which) {
   }
 }
 
+/// A hint for two stamp sequences that share no time: when their spans (or,
+/// for single stamps, their magnitudes) differ by a factor near 1e3, 1e6 or
+/// 1e9, one file is probably in ms, µs or ns and the other in s; when the
+/// spans agree but the sequences do not overlap, their time origins differ.
+/// Empty when nothing stands out.
+template <class Lazy = void>
+[[nodiscard]] std::string stamp_unit_hint(std::span<const double> ref, std::span<const double> est) {
+  if (ref.empty() || est.empty()) return {};
+  const auto magnitude = [](std::span<const double> t) {
+    const double span = t.back() - t.front();
+    return span > 0.0 ? span : std::abs(t.front());
+  };
+  const double a = magnitude(ref), b = magnitude(est);
+  if (a > 0.0 && b > 0.0 && std::isfinite(a) && std::isfinite(b)) {
+    const double decades = std::log10(a / b);
+    static constexpr const char* kUnit[] = {"s", "ms", "us", "ns"};
+    for (int k = 1; k <= 3; ++k) {
+      if (std::abs(std::abs(decades) - 3.0 * k) < 0.3) {
+        return std::string("; the reference's time span is about 1e") + std::to_string(3 * k) +
+               (decades > 0.0 ? " times the estimate's" : " times smaller than the estimate's") +
+               ": is one file in " + kUnit[k] + " and the other in s? (stamps must be in seconds)";
+      }
+    }
+  }
+  const bool overlap = ref.front() <= est.back() && est.front() <= ref.back();
+  if (!overlap) {
+    return "; the two time ranges do not overlap (reference " + format_number(ref.front()) +
+           " to " + format_number(ref.back()) + " s, estimate " + format_number(est.front()) +
+           " to " + format_number(est.back()) +
+           " s): different time origins? A constant offset is given with --t-offset";
+  }
+  return {};
+}
+
 }  // namespace detail::traj_io
 
 /// Associates two stamp sequences as evo's `associate_trajectories`
@@ -129,7 +163,8 @@ template <class Lazy = void>
                            std::to_string(ref_stamps.size()) + " stamps) and the estimate (" +
                            std::to_string(est_stamps.size()) + " stamps) with max. time diff " +
                            detail::traj_io::format_number(max_diff_s) + " s and time offset " +
-                           detail::traj_io::format_number(offset_est_s) + " s");
+                           detail::traj_io::format_number(offset_est_s) + " s" +
+                           detail::traj_io::stamp_unit_hint(ref_stamps, est_stamps));
   }
   return a;
 }

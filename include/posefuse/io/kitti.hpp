@@ -57,22 +57,41 @@ NumberedRows<Eigen::Isometry3d> read_kitti_rows(const std::filesystem::path& fil
   return rows;
 }
 
+/// The stamps of a times file, with the line of each. A repeated stamp
+/// follows `policy`; `kept` receives, for each stamp kept, the index of its
+/// data row in the file (0-based, counting data lines only), so that a
+/// caller can drop the matching poses; `all_lines` the line of every data
+/// row, kept or not.
 template <class Lazy = void>
-NumberedRows<double> read_stamp_rows(const std::filesystem::path& file) {
+NumberedRows<double> read_stamp_rows(const std::filesystem::path& file,
+                                     DuplicateStamps policy = DuplicateStamps::kError,
+                                     ReadReport* report = nullptr,
+                                     std::vector<std::size_t>* kept = nullptr,
+                                     std::vector<std::size_t>* all_lines = nullptr) {
   LineReader reader(file);
   NumberedRows<double> rows;
   std::string line;
-  while (reader.next(line)) {
+  std::size_t row = 0;
+  std::size_t previous_line = 0;
+  for (; reader.next(line);) {
     if (is_blank_or_comment(line)) continue;
     const double t = parse_row(line, 1, "one timestamp in seconds", file, reader.line_no())[0];
-    if (!rows.values.empty() && !(t > rows.values.back())) {
-      throw io_error(file, reader.line_no(),
-                     "timestamp " + format_number(t) + " is not greater than the previous one (" +
-                         format_number(rows.values.back()) + " on line " +
-                         std::to_string(rows.lines.back()) + ")");
+    if (all_lines != nullptr) all_lines->push_back(reader.line_no());
+    const StampAction action =
+        rows.values.empty()
+            ? StampAction::kAppend
+            : next_stamp_action(t, rows.values.back(), previous_line, policy, report, file,
+                                reader.line_no());
+    if (action == StampAction::kAppend) {
+      rows.values.push_back(t);
+      rows.lines.push_back(reader.line_no());
+      if (kept != nullptr) kept->push_back(row);
+    } else if (action == StampAction::kReplaceLast) {
+      rows.lines.back() = reader.line_no();
+      if (kept != nullptr) kept->back() = row;
     }
-    rows.values.push_back(t);
-    rows.lines.push_back(reader.line_no());
+    previous_line = reader.line_no();
+    ++row;
   }
   if (rows.values.empty()) throw io_error(file, "no timestamps (the file has no data lines)");
   return rows;
@@ -91,7 +110,7 @@ NumberedRows<double> read_stamp_rows(const std::filesystem::path& file) {
 ///         timestamps")
 template <class Lazy = void>
 [[nodiscard]] std::vector<double> read_kitti_times(const std::filesystem::path& file) {
-  return detail::traj_io::read_stamp_rows(file).values;
+  return detail::traj_io::read_stamp_rows(file, DuplicateStamps::kError).values;
 }
 
 /// Reads a KITTI pose file, optionally with its `times.txt`.
@@ -99,16 +118,20 @@ template <class Lazy = void>
 /// Rotations are checked against `options.rotation_tolerance` and
 /// re-orthonormalised (see ReadOptions). Without `times`, the stamps are
 /// the frame indices 0, 1, 2, ... (s), which is also what evo assumes when
-/// it treats a KITTI file as a path without timestamps.
+/// it treats a KITTI file as a path without timestamps. With `times`, equal
+/// consecutive stamps follow `options.duplicates` and the poses of dropped
+/// stamps are dropped with them (counted in `report`).
 /// @param[in] poses_file path of the pose file
 /// @param[in] times_file optional path of the matching `times.txt`
-/// @param[in] options rotation tolerance
+/// @param[in] options rotation tolerance, duplicate-stamp policy
+/// @param[out] report optional: poses dropped for a repeated stamp
 /// @return the trajectory \f$ T_{world,cam} \f$
 /// @throws posefuse::io_error (file:line) when a file cannot be opened, a
 ///         line has not 12 numbers (the message gives the count found), a
 ///         number is unparsable or not finite, a rotation is not
-///         orthonormal within tolerance or is a reflection, a stamp does not
-///         increase, or the times file has a different number of entries
+///         orthonormal within tolerance or is a reflection, a stamp is
+///         smaller than the previous (or equal, under DuplicateStamps::kError),
+///         or the times file has a different number of entries
 ///         (the error names the first line without a partner), a read fails
 ///         or a line is longer than kMaxLineBytes; and (file only) when a
 ///         path cannot be accessed or a file has no pose ("no poses") or no
@@ -117,21 +140,26 @@ template <class Lazy = void>
 [[nodiscard]] Trajectory read_kitti(
     const std::filesystem::path& poses_file,
     const std::optional<std::filesystem::path>& times_file = std::nullopt,
-    const ReadOptions& options = {}) {
+    const ReadOptions& options = {}, ReadReport* report = nullptr) {
   detail::traj_io::NumberedRows<Eigen::Isometry3d> rows =
       detail::traj_io::read_kitti_rows(poses_file, options);
   Trajectory traj;
-  traj.poses = std::move(rows.values);
   if (!times_file) {
+    traj.poses = std::move(rows.values);
     traj.t_s.resize(traj.poses.size());
     for (std::size_t k = 0; k < traj.t_s.size(); ++k) traj.t_s[k] = static_cast<double>(k);
     return traj;
   }
-  detail::traj_io::NumberedRows<double> stamps = detail::traj_io::read_stamp_rows(*times_file);
-  const std::size_t n_poses = traj.poses.size();
-  const std::size_t n_stamps = stamps.values.size();
+  ReadReport times_report;
+  std::vector<std::size_t> kept, all_lines;
+  detail::traj_io::NumberedRows<double> stamps = detail::traj_io::read_stamp_rows(
+      *times_file, options.duplicates, &times_report, &kept, &all_lines);
+  const std::size_t n_poses = rows.values.size();
+  // Counts are compared before duplicates are dropped: line k of the times
+  // file goes with data line k of the pose file.
+  const std::size_t n_stamps = all_lines.size();
   if (n_stamps > n_poses) {
-    throw io_error(*times_file, stamps.lines[n_poses],
+    throw io_error(*times_file, all_lines[n_poses],
                    "times file has " + std::to_string(n_stamps) + " timestamps but " +
                        poses_file.string() + " has " + std::to_string(n_poses) +
                        " poses; this is the first timestamp without a pose");
@@ -143,6 +171,12 @@ template <class Lazy = void>
                        " timestamps; this is the first pose without a timestamp");
   }
   traj.t_s = std::move(stamps.values);
+  traj.poses.reserve(kept.size());
+  for (const std::size_t k : kept) traj.poses.push_back(rows.values[k]);
+  if (report != nullptr) {
+    report->duplicates_dropped += times_report.duplicates_dropped;
+    if (report->first_duplicate_line == 0) report->first_duplicate_line = times_report.first_duplicate_line;
+  }
   return traj;
 }
 

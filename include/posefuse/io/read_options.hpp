@@ -1,10 +1,50 @@
 #pragma once
 /// @file
-/// Tolerances the trajectory readers apply to the rotations they read.
+/// What the trajectory readers accept: rotation tolerances and the policy for
+/// repeated timestamps, and what they report about the lines they dropped.
+
+#include <cstddef>
+#include <string>
+#include <string_view>
+
+#include <posefuse/core/error.hpp>
 
 namespace posefuse {
 
-/// How strictly the KITTI and TUM readers check rotations.
+/// What a reader does with a line whose stamp equals the previous line's.
+///
+/// Real recordings repeat stamps: the TUM RGB-D ground truth of `fr2_desk`
+/// repeats one, evo's own EuRoC `V102` test file four. Decreasing stamps are
+/// always an error (file:line); only *equal consecutive* stamps fall under
+/// this policy.
+enum class DuplicateStamps {
+  kError,  ///< refuse the file at the repeated line (file:line)
+  kFirst,  ///< keep the first pose of a run of equal stamps, drop the others
+  kLast,   ///< keep the last pose of a run of equal stamps, drop the others
+};
+
+/// Parses "error", "first" or "last".
+/// @throws posefuse::invalid_argument for any other text
+template <class Lazy = void>
+[[nodiscard]] DuplicateStamps parse_duplicate_stamps(std::string_view name) {
+  if (name == "error") return DuplicateStamps::kError;
+  if (name == "first") return DuplicateStamps::kFirst;
+  if (name == "last") return DuplicateStamps::kLast;
+  throw invalid_argument("unknown duplicate-stamp policy '" + std::string(name) +
+                         "' (expected first, last or error)");
+}
+
+/// The name `parse_duplicate_stamps` accepts for `policy`.
+[[nodiscard]] constexpr std::string_view to_string(DuplicateStamps policy) noexcept {
+  switch (policy) {
+    case DuplicateStamps::kError: return "error";
+    case DuplicateStamps::kFirst: return "first";
+    case DuplicateStamps::kLast: return "last";
+  }
+  return "?";
+}
+
+/// How strictly the KITTI and TUM readers check what they read.
 ///
 /// Real files are written with 6 to 9 significant digits and some come from
 /// odometry that composes poses in single precision, so their rotations are
@@ -18,6 +58,17 @@ struct ReadOptions {
   double rotation_tolerance = 1e-3;
   /// Largest accepted \f$ |\lVert q \rVert - 1| \f$ of a TUM quaternion.
   double quaternion_norm_tolerance = 1e-3;
+  /// Equal consecutive stamps (TUM files, KITTI `times.txt`). The library's
+  /// default refuses them so that nothing is dropped silently; programs
+  /// that accept them (`evaluate_trajectory --duplicates first`) report
+  /// what was dropped through ReadReport.
+  DuplicateStamps duplicates = DuplicateStamps::kError;
+};
+
+/// What a reader dropped under `ReadOptions::duplicates`.
+struct ReadReport {
+  std::size_t duplicates_dropped = 0;     ///< poses dropped for a repeated stamp
+  std::size_t first_duplicate_line = 0;   ///< 1-based line of the first repeat (0: none)
 };
 
 }  // namespace posefuse

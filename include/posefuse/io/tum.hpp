@@ -26,20 +26,23 @@ namespace posefuse {
 /// Reads a TUM trajectory file.
 ///
 /// Quaternions within `options.quaternion_norm_tolerance` of unit norm are
-/// normalised (as evo does for every non-zero quaternion).
+/// normalised (as evo does for every non-zero quaternion). Equal consecutive
+/// stamps follow `options.duplicates`; what was dropped is counted in `report`.
 /// @param[in] file path of the TUM file
-/// @param[in] options quaternion norm tolerance
-/// @return the trajectory \f$ T_{world,body}(t) \f$
+/// @param[in] options quaternion norm tolerance, duplicate-stamp policy
+/// @param[out] report optional: poses dropped for a repeated stamp
+/// @return the trajectory \f$ T_{world,body}(t) \f$, stamps strictly increasing
 /// @throws posefuse::io_error (file:line) when the file cannot be opened, a
 ///         line has not 8 numbers (the message gives the count found), a
 ///         number is unparsable or not finite, a quaternion is zero or too
-///         far from unit norm, a stamp is not greater than the previous, a
-///         read fails or a line is longer than kMaxLineBytes; and (file
-///         only) when the path cannot be accessed or the file has no pose
-///         ("no poses")
+///         far from unit norm, a stamp is smaller than the previous (or
+///         equal, under DuplicateStamps::kError), a read fails or a line is
+///         longer than kMaxLineBytes; and (file only) when the path cannot
+///         be accessed or the file has no pose ("no poses")
 template <class Lazy = void>
 [[nodiscard]] Trajectory read_tum(const std::filesystem::path& file,
-                                  const ReadOptions& options = {}) {
+                                  const ReadOptions& options = {},
+                                  ReadReport* report = nullptr) {
   detail::LineReader reader(file);
   Trajectory traj;
   std::size_t previous_line = 0;
@@ -49,20 +52,21 @@ template <class Lazy = void>
     const std::size_t n = reader.line_no();
     const std::vector<double> v =
         detail::traj_io::parse_row(line, 8, "TUM: t tx ty tz qx qy qz qw", file, n);
-    if (!traj.t_s.empty() && !(v[0] > traj.t_s.back())) {
-      throw io_error(file, n,
-                     "timestamp " + detail::traj_io::format_number(v[0]) +
-                         " is not greater than the previous one (" +
-                         detail::traj_io::format_number(traj.t_s.back()) + " on line " +
-                         std::to_string(previous_line) + ")");
-    }
     // Eigen's constructor takes (w, x, y, z); the file stores x y z w.
     const Eigen::Quaterniond q = detail::traj_io::checked_quaternion(
         Eigen::Quaterniond(v[7], v[4], v[5], v[6]), options.quaternion_norm_tolerance, file, n);
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
     T.linear() = q.toRotationMatrix();
     T.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
-    traj.push_back(v[0], T);
+    const detail::traj_io::StampAction action =
+        traj.t_s.empty() ? detail::traj_io::StampAction::kAppend
+                         : detail::traj_io::next_stamp_action(v[0], traj.t_s.back(), previous_line,
+                                                              options.duplicates, report, file, n);
+    if (action == detail::traj_io::StampAction::kAppend) {
+      traj.push_back(v[0], T);
+    } else if (action == detail::traj_io::StampAction::kReplaceLast) {
+      traj.poses.back() = T;
+    }
     previous_line = n;
   }
   if (traj.empty()) throw io_error(file, "no poses (the file has no data lines)");

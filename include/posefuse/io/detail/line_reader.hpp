@@ -40,8 +40,9 @@ template <class Lazy = void>
   return st;
 }
 
-/// Reads a text file line by line, counting 1-based line numbers and
-/// stripping a trailing '\r' (files written on Windows).
+/// Reads a text file line by line, counting 1-based line numbers, stripping
+/// a trailing '\r' (files written on Windows) and a UTF-8 byte-order mark
+/// at the start of the file.
 class LineReader {
  public:
   /// @throws posefuse::io_error when the file cannot be accessed or opened,
@@ -88,6 +89,9 @@ class LineReader {
     if (!any) return false;
     ++line_no_;
     if (!line.empty() && line.back() == '\r') line.pop_back();
+    // A UTF-8 byte-order mark (EF BB BF) that some editors put at the start
+    // of a file is not part of the first field.
+    if (line_no_ == 1 && line.starts_with("\xEF\xBB\xBF")) line.erase(0, 3);
     return true;
   }
   /// 1-based number of the line last read.
