@@ -30,13 +30,14 @@
 //
 // prints rmse 12.978526 m and "scale 24.841695". Add --metric rpe --delta 100
 // --delta-unit m for the relative error per 100 m, --json for machine-readable
-// output, --save-results FILE to keep everything (statistics, per-pose errors,
+// output, --plot FILE.svg for a picture, --save-results FILE to keep everything (statistics, per-pose errors,
 // options) as JSON. evo_ape / evo_rpe options are spelled with dashes
 // (--t-offset, --align-origin, --n-to-align, ...; see --help and README).
 // Repeated timestamps are kept first by default (--duplicates) and reported
 // as a "warning:" line on stderr. Bad input exits with 2 (usage) or 1 (data,
 // naming file:line where a file is at fault), one line on stderr.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -50,6 +51,7 @@
 #include <apps/cli.hpp>
 #include <apps/json.hpp>
 #include <apps/output_file.hpp>
+#include <apps/svg.hpp>
 #include <posefuse/eval/metrics.hpp>
 #include <posefuse/eval/trajectory_filters.hpp>
 #include <posefuse/io/association.hpp>
@@ -61,7 +63,8 @@ namespace apps = posefuse::apps;
 
 struct Options {
   std::filesystem::path groundtruth, estimate;
-  std::optional<std::filesystem::path> times, save_results;
+  std::optional<std::filesystem::path> times, save_results, plot;
+  posefuse::Plane plot_mode = posefuse::Plane::kXY;
   posefuse::Format ref_format = posefuse::Format::kKitti;
   posefuse::Format est_format = posefuse::Format::kKitti;
   posefuse::DuplicateStamps duplicates = posefuse::DuplicateStamps::kFirst;
@@ -176,6 +179,13 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   cli.path({.name = "--save-results", .value = "FILE",
             .help = "write statistics, per-pose errors and options as JSON"},
            o.save_results);
+  cli.path({.name = "--plot", .value = "FILE.svg",
+            .help = "draw both trajectories (EST aligned, coloured by error) and the\n"
+                    "error over time with its statistics"},
+           o.plot);
+  cli.custom({.name = "--plot-mode", .value = "xy|xz|yz", .help = "the plane of the trajectory view",
+              .default_text = "xy"},
+             [&](std::string_view v) { o.plot_mode = posefuse::parse_plane(v); });
   cli.flag({.name = "--json", .help = "print one JSON object instead of the table"}, o.json);
   cli.epilogue(
       "Two KITTI files without --times are compared frame by frame (equal counts);\n"
@@ -365,6 +375,100 @@ std::string results_json(const Options& o, const posefuse::MetricResult& r,
   return out.str();
 }
 
+/// The --plot document: top, the trajectories in the chosen plane (REF
+/// dashed black, EST aligned, its segments coloured by the error at their
+/// end pose in six bins between the smallest and largest error); bottom, the
+/// error over time (s from REF's first associated stamp) with rmse, mean and
+/// median as horizontal lines.
+std::string plot_svg(const Options& o, const posefuse::MetricResult& r,
+                     const posefuse::Trajectory& ref_used, const posefuse::Trajectory& est_used) {
+  namespace svg = apps::svg;
+  const posefuse::Trajectory est_aligned = posefuse::apply_alignment(est_used, r.alignment);
+  const std::string unit(posefuse::unit_of(o.relation));
+  const std::string metric = o.metric_rpe ? "RPE" : "APE";
+  const std::string plane(posefuse::to_string(o.plot_mode));
+  const auto xy = [&](const Eigen::Isometry3d& T) {
+    const Eigen::Vector2d p = posefuse::project_to_plane(T, o.plot_mode);
+    return svg::Point{p.x(), p.y()};
+  };
+  // Error per pose: APE one per pose; RPE the pair ending at that pose.
+  std::vector<double> error(ref_used.size(), std::nan(""));
+  if (o.metric_rpe) {
+    for (std::size_t k = 0; k < r.pairs.size(); ++k) error[r.pairs[k].second] = r.errors[k];
+  } else {
+    error = r.errors;
+  }
+  svg::Plot paths(metric + " " + relation_title(o.relation) + " along the path, alignment " +
+                  alignment_name(o));
+  paths.x_axis(std::string(1, plane[0]), "m").y_axis(std::string(1, plane[1]), "m").equal_aspect();
+  std::vector<svg::Point> ref_points, est_points;
+  for (const auto& T : ref_used.poses) ref_points.push_back(xy(T));
+  for (const auto& T : est_aligned.poses) est_points.push_back(xy(T));
+  paths.line("reference", ref_points, {"#000000", 1.5, "6,3"});
+  paths.line("", est_points, {"#b0b0b0", 1.0, {}});
+  static constexpr const char* kColours[] = {"#440154", "#414487", "#2a788e",
+                                             "#22a884", "#7ad151", "#fde725"};  // viridis
+  constexpr int kBins = 6;
+  const double lo = r.stats.min, hi = r.stats.max;
+  const auto bin_of = [&](double e) {
+    if (!(hi > lo)) return 0;
+    return std::min(kBins - 1, static_cast<int>((e - lo) / (hi - lo) * kBins));
+  };
+  for (int b = 0; b < kBins; ++b) {
+    bool legend_done = false;
+    std::vector<svg::Point> run;
+    const auto flush = [&]() {
+      if (run.size() >= 2) {
+        char label[96];
+        std::snprintf(label, sizeof(label), "estimate, error %.3g to %.3g %s",
+                      lo + (hi - lo) * b / kBins, lo + (hi - lo) * (b + 1) / kBins, unit.c_str());
+        paths.line(legend_done ? "" : label, run, {kColours[b], 2.5, {}});
+        legend_done = true;
+      }
+      run.clear();
+    };
+    for (std::size_t k = 1; k < est_points.size(); ++k) {
+      if (std::isfinite(error[k]) && bin_of(error[k]) == b) {
+        if (run.empty()) run.push_back(est_points[k - 1]);
+        run.push_back(est_points[k]);
+      } else {
+        flush();
+      }
+    }
+    flush();
+  }
+  // KITTI files without --times carry frame indices, not times.
+  const bool indices = o.ref_format == posefuse::Format::kKitti &&
+                       o.est_format == posefuse::Format::kKitti && !o.times;
+  svg::Plot over_time(metric + (indices ? " per pose (" : " over time (") +
+                      std::to_string(r.stats.count) + " values)");
+  if (indices) {
+    over_time.x_axis("pose index");
+  } else {
+    over_time.x_axis("t", "s");
+  }
+  over_time.y_axis(metric, unit);
+  std::vector<svg::Point> series;
+  const double t0 = ref_used.t_s.front();
+  for (std::size_t k = 0; k < error.size(); ++k)
+    if (std::isfinite(error[k])) series.push_back({ref_used.t_s[k] - t0, error[k]});
+  over_time.line(metric, series, {"#1f77b4", 1.2, {}});
+  const double t1 = ref_used.t_s.back() - t0;
+  const auto level = [&](const char* name, double v, const char* colour, const char* dash) {
+    char label[64];
+    std::snprintf(label, sizeof(label), "%s %.4g %s", name, v, unit.c_str());
+    over_time.line(label, std::vector<svg::Point>{{0.0, v}, {t1, v}}, {colour, 1.5, dash});
+  };
+  level("rmse", r.stats.rmse, "#d62728", "");
+  level("mean", r.stats.mean, "#2ca02c", "6,3");
+  level("median", r.stats.median, "#9467bd", "2,2");
+  over_time.include({0.0, 0.0});
+  svg::Document doc(760, 1180);
+  doc.plot(paths, {0, 0, 760, 700});
+  doc.plot(over_time, {0, 700, 760, 480});
+  return doc.str();
+}
+
 posefuse::Trajectory thin(const posefuse::Trajectory& traj, const Options& o) {
   posefuse::Trajectory out = traj;
   if (o.downsample) out = posefuse::downsample(out, *o.downsample);
@@ -414,6 +518,7 @@ int run(const Options& o) {
                                                : posefuse::ape(ref_sync, est_sync, o.relation, o.align);
   apps::OutputFiles outputs;
   if (o.save_results) outputs.add(*o.save_results, results_json(o, result, ref_sync, warnings));
+  if (o.plot) outputs.add(*o.plot, plot_svg(o, result, ref_sync, est_sync));
   outputs.commit();
   if (o.json) {
     print_json(o, result);

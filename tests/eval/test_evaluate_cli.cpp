@@ -18,6 +18,7 @@
 
 #include "support/synthetic_trajectory.hpp"
 #include "support/run_program.hpp"
+#include "support/xml_check.hpp"
 
 namespace {
 
@@ -293,4 +294,31 @@ TEST_CASE("Evaluate CLI: repeated stamps, byte-order marks and stamp units", "[e
   CHECK(origin.status == 1);
   CHECK(origin.err.find("different time origins? A constant offset is given with --t-offset") !=
         std::string::npos);
+}
+
+TEST_CASE("Evaluate CLI: --plot draws both views as well-formed SVG", "[eval][cli][plot]") {
+  POSEFUSE_REQUIRE_EXAMPLE(exe, "evaluate_trajectory");
+  posefuse::test::TempDir dir("cli-plot");
+  const posefuse::Trajectory ref = posefuse::test::make_vehicle_trajectory(200, 51, 10.0);
+  posefuse::write_tum(dir.path() / "ref.tum", ref);
+  posefuse::write_tum(dir.path() / "est.tum", posefuse::test::perturb(ref, 0.3, 0.01, 52));
+  const std::string files = "--format tum --groundtruth '" + (dir.path() / "ref.tum").string() +
+                            "' --estimate '" + (dir.path() / "est.tum").string() + "'";
+  for (const std::string& extra : {std::string(" --align se3"), std::string(" --metric rpe --delta 5 --plot-mode xz")}) {
+    INFO(extra);
+    const auto svg = dir.path() / "plot.svg";
+    const Run r = run(exe, files + extra + " --plot '" + svg.string() + "'", dir);
+    REQUIRE(r.status == 0);
+    const std::string text = posefuse::test::slurp(svg);
+    CHECK(posefuse::test::xml_problem(text).empty());
+    CHECK(posefuse::test::xml_problem(text + "<g>") == "more than one root element");  // the checker bites
+    CHECK(text.find(">reference</text>") != std::string::npos);
+    CHECK(text.find(">t (s)</text>") != std::string::npos);
+    CHECK(text.find(">rmse ") != std::string::npos);
+    CHECK(text.find("estimate, error ") != std::string::npos);
+    CHECK(text.find("font-family") != std::string::npos);
+  }
+  CHECK(posefuse::test::xml_problem("<svg a=\"1\" a=\"2\"/>") == "attribute a twice in <svg");
+  CHECK(posefuse::test::xml_problem("<svg><g></svg>") == "</svg> does not close the open element");
+  CHECK(posefuse::test::xml_problem("<svg>a & b</svg>") == "unterminated entity");
 }
