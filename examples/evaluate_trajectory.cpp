@@ -52,6 +52,7 @@
 #include <apps/json.hpp>
 #include <apps/output_file.hpp>
 #include <apps/svg.hpp>
+#include <posefuse/eval/consistency.hpp>
 #include <posefuse/eval/metrics.hpp>
 #include <posefuse/eval/trajectory_filters.hpp>
 #include <posefuse/io/association.hpp>
@@ -192,6 +193,8 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
       "otherwise poses are associated by timestamp like evo's --t_max_diff.\n"
       "Order as evo: --downsample/--motion-filter, --t-start/--t-end (REF),\n"
       "association (--t-offset), alignment, --project-to-plane, metric.\n"
+      "A TUM estimate may carry a covariance per pose (14 or 29 columns, README):\n"
+      "APE then also reports NEES with its chi-square bounds.\n"
       "Exit status: 0 ok, 1 bad data (file:line where a file is at fault), 2 bad usage.");
   if (!cli.parse(cmd)) return std::nullopt;
 
@@ -238,15 +241,31 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   return o;
 }
 
-posefuse::Trajectory load(const std::filesystem::path& file, posefuse::Format format,
-                          const std::optional<std::filesystem::path>& times,
-                          posefuse::DuplicateStamps duplicates, std::vector<std::string>& warnings) {
+/// A file's trajectory and, for a TUM estimate with covariance columns, the
+/// covariance of each pose (empty otherwise).
+struct Loaded {
+  posefuse::Trajectory trajectory;
+  int covariance_dim = 0;
+  std::vector<Eigen::Matrix<double, 6, 6>> covariance;
+};
+
+Loaded load(const std::filesystem::path& file, posefuse::Format format,
+            const std::optional<std::filesystem::path>& times, posefuse::DuplicateStamps duplicates,
+            bool allow_covariance, std::vector<std::string>& warnings) {
   posefuse::ReadOptions options;
   options.duplicates = duplicates;
   posefuse::ReadReport report;
-  posefuse::Trajectory traj = format == posefuse::Format::kKitti
-                                  ? posefuse::read_kitti(file, times, options, &report)
-                                  : posefuse::read_tum(file, options, &report);
+  Loaded out;
+  if (format == posefuse::Format::kKitti) {
+    out.trajectory = posefuse::read_kitti(file, times, options, &report);
+  } else if (allow_covariance) {
+    posefuse::TumWithCovariance t = posefuse::read_tum_with_covariance(file, options, &report);
+    out.trajectory = std::move(t.trajectory);
+    out.covariance_dim = t.covariance_dim;
+    out.covariance = std::move(t.covariance);
+  } else {
+    out.trajectory = posefuse::read_tum(file, options, &report);
+  }
   if (report.duplicates_dropped > 0) {
     const std::filesystem::path& where = format == posefuse::Format::kKitti ? *times : file;
     warnings.push_back(where.string() + ":" + std::to_string(report.first_duplicate_line) +
@@ -255,7 +274,24 @@ posefuse::Trajectory load(const std::filesystem::path& file, posefuse::Format fo
                        std::string(posefuse::to_string(duplicates)) +
                        " of each run; --duplicates error refuses them)");
   }
-  return traj;
+  return out;
+}
+
+/// NEES of the associated estimate, when its file carried covariances (APE only).
+std::optional<posefuse::NeesResult> consistency(const Options& o, const Loaded& est_file,
+                                                const posefuse::Trajectory& ref_sync,
+                                                const posefuse::Trajectory& est_sync,
+                                                const posefuse::MetricResult& result) {
+  if (est_file.covariance_dim == 0 || o.metric_rpe) return std::nullopt;
+  // Associated poses keep their file's stamps: find each one's covariance.
+  std::vector<Eigen::Matrix<double, 6, 6>> covariance;
+  covariance.reserve(est_sync.size());
+  const std::vector<double>& stamps = est_file.trajectory.t_s;
+  for (const double t : est_sync.t_s) {
+    const auto it = std::lower_bound(stamps.begin(), stamps.end(), t);
+    covariance.push_back(est_file.covariance[static_cast<std::size_t>(it - stamps.begin())]);
+  }
+  return posefuse::nees(ref_sync, est_sync, covariance, est_file.covariance_dim, result.alignment);
 }
 
 std::string relation_title(posefuse::PoseRelation r) {
@@ -281,7 +317,8 @@ std::string alignment_name(const Options& o) {
   return std::string(posefuse::to_string(o.align.alignment));
 }
 
-void print_table(const Options& o, const posefuse::MetricResult& r, std::size_t n_ref,
+void print_table(const Options& o, const posefuse::MetricResult& r,
+                 const std::optional<posefuse::NeesResult>& nees, std::size_t n_ref,
                  std::size_t n_est) {
   std::printf("%s w.r.t. %s, alignment %s", o.metric_rpe ? "RPE" : "APE",
               relation_title(o.relation).c_str(), alignment_name(o).c_str());
@@ -304,10 +341,18 @@ void print_table(const Options& o, const posefuse::MetricResult& r, std::size_t 
   if (o.align.alignment == posefuse::Alignment::kSim3 ||
       o.align.alignment == posefuse::Alignment::kScale)
     std::printf("scale  %11.6f\n", r.alignment.scale);
+  if (nees) {
+    std::printf("NEES   %11.6f  (%d-D; consistent between %.4f and %.4f at %g %%: %s)\n",
+                nees->mean, nees->dim, nees->lower, nees->upper, 100.0 * nees->confidence,
+                nees->consistent()             ? "consistent"
+                : nees->mean > nees->upper     ? "overconfident, covariance too small"
+                                               : "underconfident, covariance too large");
+  }
 }
 
 /// The summary members shared by --json and --save-results.
-void write_summary(apps::JsonWriter& j, const Options& o, const posefuse::MetricResult& r) {
+void write_summary(apps::JsonWriter& j, const Options& o, const posefuse::MetricResult& r,
+                   const std::optional<posefuse::NeesResult>& nees) {
   const posefuse::Statistics& s = r.stats;
   j.member("metric", o.metric_rpe ? "rpe" : "ape")
       .member("pose_relation", relation_name(o.relation))
@@ -319,25 +364,32 @@ void write_summary(apps::JsonWriter& j, const Options& o, const posefuse::Metric
   }
   j.member("count", s.count).member("rmse", s.rmse).member("mean", s.mean).member("median", s.median);
   j.member("std", s.std).member("min", s.min).member("max", s.max).member("sse", s.sse);
+  if (nees) {
+    j.member("nees_mean", nees->mean).member("nees_dim", nees->dim);
+    j.member("nees_lower", nees->lower).member("nees_upper", nees->upper);
+    j.member("nees_consistent", nees->consistent());
+  }
 }
 
 /// One JSON object on one line; numbers round-trip, non-finite ones are null.
-void print_json(const Options& o, const posefuse::MetricResult& r) {
+void print_json(const Options& o, const posefuse::MetricResult& r,
+                const std::optional<posefuse::NeesResult>& nees) {
   apps::JsonWriter j(std::cout);
   j.begin_object(apps::JsonWriter::Layout::kInline);
-  write_summary(j, o, r);
+  write_summary(j, o, r, nees);
   j.end_object().finish();
 }
 
 /// The --save-results document: the summary, the options that shaped it,
 /// and per pose (APE) or pair (RPE) the stamp(s) and the error.
 std::string results_json(const Options& o, const posefuse::MetricResult& r,
+                         const std::optional<posefuse::NeesResult>& nees,
                          const posefuse::Trajectory& ref_used,
                          const std::vector<std::string>& warnings) {
   std::ostringstream out;
   apps::JsonWriter j(out);
   j.begin_object();
-  write_summary(j, o, r);
+  write_summary(j, o, r, nees);
   j.key("options").begin_object();
   j.member("groundtruth", o.groundtruth.string()).member("estimate", o.estimate.string());
   j.member("groundtruth_format", posefuse::to_string(o.ref_format))
@@ -363,6 +415,11 @@ std::string results_json(const Options& o, const posefuse::MetricResult& r,
   j.key("errors").begin_array();
   for (const double e : r.errors) j.value(e);
   j.end_array();
+  if (nees) {
+    j.key("nees").begin_array();
+    for (const double e : nees->nees) j.value(e);
+    j.end_array();
+  }
   // Stamps of the reference pose each error belongs to (RPE: the pair's end).
   j.key("stamps_s").begin_array();
   if (o.metric_rpe) {
@@ -481,8 +538,10 @@ posefuse::Trajectory thin(const posefuse::Trajectory& traj, const Options& o) {
 
 int run(const Options& o) {
   std::vector<std::string> warnings;
-  const posefuse::Trajectory ref_file = load(o.groundtruth, o.ref_format, o.times, o.duplicates, warnings);
-  const posefuse::Trajectory est_file = load(o.estimate, o.est_format, o.times, o.duplicates, warnings);
+  const posefuse::Trajectory ref_file =
+      load(o.groundtruth, o.ref_format, o.times, o.duplicates, false, warnings).trajectory;
+  const Loaded est_loaded = load(o.estimate, o.est_format, o.times, o.duplicates, true, warnings);
+  const posefuse::Trajectory& est_file = est_loaded.trajectory;
   for (const std::string& w : warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   posefuse::Trajectory ref = thin(ref_file, o);
   const posefuse::Trajectory est = thin(est_file, o);
@@ -516,14 +575,18 @@ int run(const Options& o) {
   }
   posefuse::MetricResult result = o.metric_rpe ? posefuse::rpe(ref_sync, est_sync, o.rpe)
                                                : posefuse::ape(ref_sync, est_sync, o.relation, o.align);
+  if (o.align.project_to_plane && est_loaded.covariance_dim > 0 && !o.metric_rpe)
+    throw apps::usage_error("NEES (an estimate with covariance) cannot be combined with --project-to-plane");
+  const std::optional<posefuse::NeesResult> nees =
+      consistency(o, est_loaded, ref_sync, est_sync, result);
   apps::OutputFiles outputs;
-  if (o.save_results) outputs.add(*o.save_results, results_json(o, result, ref_sync, warnings));
+  if (o.save_results) outputs.add(*o.save_results, results_json(o, result, nees, ref_sync, warnings));
   if (o.plot) outputs.add(*o.plot, plot_svg(o, result, ref_sync, est_sync));
   outputs.commit();
   if (o.json) {
-    print_json(o, result);
+    print_json(o, result, nees);
   } else {
-    print_table(o, result, ref_file.size(), est_file.size());
+    print_table(o, result, nees, ref_file.size(), est_file.size());
   }
   return 0;
 }

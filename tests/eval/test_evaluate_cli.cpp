@@ -322,3 +322,36 @@ TEST_CASE("Evaluate CLI: --plot draws both views as well-formed SVG", "[eval][cl
   CHECK(posefuse::test::xml_problem("<svg><g></svg>") == "</svg> does not close the open element");
   CHECK(posefuse::test::xml_problem("<svg>a & b</svg>") == "unterminated entity");
 }
+
+TEST_CASE("Evaluate CLI: an estimate with covariance columns reports NEES", "[eval][cli][nees]") {
+  POSEFUSE_REQUIRE_EXAMPLE(exe, "evaluate_trajectory");
+  posefuse::test::TempDir dir("cli-nees");
+  const posefuse::Trajectory ref = posefuse::test::make_vehicle_trajectory(100, 71, 10.0);
+  posefuse::write_tum(dir.path() / "ref.tum", ref);
+  // Every estimate pose is 0.1 m off along x with covariance 0.01 I (6x6):
+  // NEES = 0.1^2 / 0.01 = 1 at every pose.
+  std::ofstream est(dir.path() / "est.tum");
+  est.precision(17);
+  for (std::size_t k = 0; k < ref.size(); ++k) {
+    const Eigen::Vector3d p = ref.poses[k].translation() + Eigen::Vector3d(0.1, 0, 0);
+    const Eigen::Quaterniond q(ref.poses[k].linear());
+    est << ref.t_s[k] << ' ' << p.x() << ' ' << p.y() << ' ' << p.z() << ' ' << q.x() << ' '
+        << q.y() << ' ' << q.z() << ' ' << q.w();
+    for (int i = 0; i < 6; ++i)
+      for (int j = i; j < 6; ++j) est << (i == j ? " 0.01" : " 0");
+    est << '\n';
+  }
+  est.close();
+  const std::string files = "--format tum --groundtruth '" + (dir.path() / "ref.tum").string() +
+                            "' --estimate '" + (dir.path() / "est.tum").string() + "'";
+  const Run r = run(exe, files + " --json", dir);
+  REQUIRE(r.status == 0);
+  const Json j = Json::parse(r.out);
+  CHECK(j["nees_dim"].number() == 6.0);
+  CHECK(j["nees_mean"].number() == Approx(1.0).epsilon(1e-9));
+  CHECK(j["nees_consistent"].boolean() == false);  // 1 is far below 6: covariance too large
+  const Run table = run(exe, files, dir);
+  CHECK(table.out.find("underconfident, covariance too large") != std::string::npos);
+  const Run rpe = run(exe, files + " --metric rpe --json", dir);
+  CHECK_FALSE(Json::parse(rpe.out).has("nees_mean"));  // NEES is an APE check
+}
