@@ -355,3 +355,46 @@ TEST_CASE("Evaluate CLI: an estimate with covariance columns reports NEES", "[ev
   const Run rpe = run(exe, files + " --metric rpe --json", dir);
   CHECK_FALSE(Json::parse(rpe.out).has("nees_mean"));  // NEES is an APE check
 }
+
+TEST_CASE("compare_results: tabulates saved results and ranks comparable ones", "[eval][cli][compare]") {
+  POSEFUSE_REQUIRE_EXAMPLE(eval, "evaluate_trajectory");
+  POSEFUSE_REQUIRE_EXAMPLE(exe, "compare_results");
+  posefuse::test::TempDir dir("cli-compare");
+  const posefuse::Trajectory ref = posefuse::test::make_vehicle_trajectory(150, 81, 10.0);
+  posefuse::write_tum(dir.path() / "ref.tum", ref);
+  posefuse::write_tum(dir.path() / "good.tum", posefuse::test::perturb(ref, 0.1, 0.01, 82));
+  posefuse::write_tum(dir.path() / "bad.tum", posefuse::test::perturb(ref, 0.5, 0.01, 83));
+  const auto save = [&](const std::string& est, const std::string& name, const std::string& extra) {
+    const auto out = dir.path() / (name + ".json");
+    const Run r = run(eval, "--format tum --groundtruth '" + (dir.path() / "ref.tum").string() +
+                                "' --estimate '" + (dir.path() / (est + ".tum")).string() +
+                                "' --save-results '" + out.string() + "'" + extra,
+                      dir);
+    REQUIRE(r.status == 0);
+    return out;
+  };
+  const auto good = save("good", "good", ""), bad = save("bad", "bad", "");
+  const Run r = run(exe, "--result '" + bad.string() + "' --result '" + good.string() + "' --json", dir);
+  REQUIRE(r.status == 0);
+  const Json j = Json::parse(r.out);
+  REQUIRE(j.array().size() == 2);
+  CHECK(j[0]["name"].string() == "bad");
+  CHECK(j[1]["rmse"].number() == Json::parse(posefuse::test::slurp(good))["rmse"].number());
+  const Run table = run(exe, "--result '" + bad.string() + "' --result '" + good.string() +
+                                 "' --label B,G", dir);
+  CHECK(table.out.find("lowest rmse: G") != std::string::npos);
+  CHECK(table.err.empty());
+  // A different metric is listed but not ranked.
+  const auto rpe = save("good", "good_rpe", " --metric rpe");
+  const Run mixed = run(exe, "--result '" + good.string() + "' --result '" + rpe.string() + "'", dir);
+  CHECK(mixed.status == 0);
+  CHECK(mixed.err.rfind("warning: the results measure different metrics", 0) == 0);
+  CHECK(mixed.out.find("lowest rmse") == std::string::npos);
+  // Errors: no result (usage), a file that is not a result (data, named).
+  CHECK(run(exe, "", dir).status == 2);
+  CHECK(run(exe, "--result '" + good.string() + "' --label a,b", dir).status == 2);
+  std::ofstream(dir.path() / "x.json") << "{\"rmse\": 1}";
+  const Run broken = run(exe, "--result '" + (dir.path() / "x.json").string() + "'", dir);
+  CHECK(broken.status == 1);
+  CHECK(broken.err.find("x.json: not a saved result") != std::string::npos);
+}
