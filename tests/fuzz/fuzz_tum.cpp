@@ -7,6 +7,9 @@
 // the rotations to within kRotationRoundTrip (write_tum documents "about
 // 1e-16": the rotation goes matrix -> quaternion -> text -> quaternion ->
 // matrix, a few roundings per step; 2e6 random rotations needed 7 eps).
+// The same input also goes through read_tum_with_covariance with repeated
+// stamps kept first: it validate()s, has one covariance per pose when it
+// has covariance columns, each symmetric and positive definite in its block.
 
 #include <Eigen/Core>
 #include <cstddef>
@@ -34,6 +37,25 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   static const posefuse_fuzz::ScratchDir dir("tum");
   const auto file = dir / "traj.tum";
   posefuse_fuzz::write_bytes(file, std::string_view(reinterpret_cast<const char*>(data), size));
+  try {
+    posefuse::ReadOptions options;
+    options.duplicates = posefuse::DuplicateStamps::kFirst;
+    posefuse::ReadReport report;
+    const posefuse::TumWithCovariance c = posefuse::read_tum_with_covariance(file, options, &report);
+    c.trajectory.validate();
+    require(c.covariance_dim == 0 || c.covariance.size() == c.trajectory.size(),
+            "read_tum_with_covariance: covariance count differs from pose count");
+    for (const auto& C : c.covariance) {
+      require(C == C.transpose(), "read_tum_with_covariance: covariance not symmetric");
+      const bool pd = c.covariance_dim == 3 ? posefuse::is_positive_definite(C.topLeftCorner<3, 3>().eval())
+                                            : posefuse::is_positive_definite(C);
+      require(pd, "read_tum_with_covariance: covariance not positive definite");
+    }
+  } catch (const posefuse::io_error& e) {
+    require(!e.file().empty(), "io_error without a file name");
+  } catch (const posefuse::invalid_argument& e) {
+    posefuse_fuzz::finding(std::string("read_tum_with_covariance returned an invalid trajectory: ") + e.what());
+  }
   posefuse::Trajectory traj;
   try {
     traj = posefuse::read_trajectory(file, posefuse::Format::kTum);
