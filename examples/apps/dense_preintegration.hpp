@@ -5,8 +5,8 @@
 /// forms the full 15x15 transition F and the 15x18 noise Jacobian G and
 /// computes \f$ J' = F J \f$ and \f$ P' = F P F^\top + G Q G^\top \f$
 /// (Qin et al., VINS-Mono, IEEE T-RO 2018, eq 9-11; about 38 kflop a sample).
-/// Same mathematics as the structured update — the same mid-point step
-/// (detail::midpoint_step), the same F blocks, the same noise model — so the
+/// Same mathematics as the structured update — the same mid-point step,
+/// the same F blocks (in the right, body form of the rotation error), the same noise model — so the
 /// two agree to rounding (tests/inertial, 1e-12); it exists only as the
 /// benchmark's and the test's reference. Not part of the library.
 
@@ -14,6 +14,45 @@
 #include <posefuse/inertial/preintegration.hpp>
 
 namespace posefuse::apps {
+
+/// Blocks of one mid-point step's transition in the right (body) form of
+/// inertial/preintegration.hpp's file comment.
+struct MidpointStep {
+  Eigen::Matrix3d E_T;     ///< \f$ \mathrm{Exp}(\bar\omega\delta t)^\top \f$
+  Eigen::Matrix3d Jr_dt;   ///< \f$ J_r(\bar\omega\delta t)\,\delta t \f$
+  Eigen::Matrix3d U_phi;   ///< \f$ \partial\bar u/\partial\delta\phi \f$
+  Eigen::Matrix3d U_ba;    ///< \f$ \partial\bar u/\partial b_a \f$
+  Eigen::Matrix3d U_bg;    ///< \f$ \partial\bar u/\partial b_g \f$
+  Eigen::Matrix3d R0;      ///< \f$ \Delta R_k \f$
+  Eigen::Matrix3d R1;      ///< \f$ \Delta R_{k+1} \f$
+  Eigen::Matrix3d K;       ///< \f$ R_1[a'_{k+1}]_\times J_r\,\delta t \f$
+};
+
+/// Advances (p, R, v) by one mid-point step and returns the step's blocks.
+inline MidpointStep midpoint_step(const ImuSample& s0, const ImuSample& s1, const ImuBias& bias,
+                                  double dt, Eigen::Vector3d& p, SO3d& R, Eigen::Vector3d& v) {
+  MidpointStep st;
+  const Eigen::Vector3d w = 0.5 * (s0.gyro_radps + s1.gyro_radps) - bias.gyro;
+  const Eigen::Vector3d a0 = s0.accel_mps2 - bias.accel;
+  const Eigen::Vector3d a1 = s1.accel_mps2 - bias.accel;
+  SO3d::Jacobian Jr;
+  const SO3d E = SO3d::exp(Eigen::Vector3d(w * dt), &Jr);
+  const SO3d R_next = R.compose(E);
+  st.R0 = R.matrix();
+  st.R1 = R_next.matrix();
+  st.E_T = E.matrix().transpose();
+  st.Jr_dt = Jr * dt;
+  const Eigen::Vector3d u = 0.5 * (st.R0 * a0 + st.R1 * a1);
+  const Eigen::Matrix3d R1_a1x = st.R1 * SO3d::hat(a1);
+  st.U_phi = -0.5 * (st.R0 * SO3d::hat(a0) + R1_a1x * st.E_T);
+  st.U_ba = -0.5 * (st.R0 + st.R1);
+  st.K = R1_a1x * st.Jr_dt;
+  st.U_bg = 0.5 * st.K;
+  p += v * dt + (0.5 * dt * dt) * u;
+  v += u * dt;
+  R = R_next;
+  return st;
+}
 
 /// Dense-matrix pre-integration (see the file comment); samples must be
 /// given in order (no status checks: it is a reference, not an API).
@@ -35,7 +74,7 @@ class DensePreintegration {
       return;
     }
     const double dt = seconds_between(s.t_ns, last_.t_ns);
-    const detail::MidpointStep st = detail::midpoint_step(last_, s, bias_, dt, p_, R_, v_);
+    const MidpointStep st = midpoint_step(last_, s, bias_, dt, p_, R_, v_);
     const double h = 0.5 * dt * dt;
     Matrix15 F = Matrix15::Identity();  // order p, φ, v, b_a, b_g
     F.block<3, 3>(0, 3) = h * st.U_phi;

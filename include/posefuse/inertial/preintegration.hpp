@@ -89,6 +89,15 @@
 #include <posefuse/core/time.hpp>
 #include <posefuse/lie/so3.hpp>
 
+// Inline every Eigen helper of the per-sample step into it (g++ and clang):
+// the step is ~40 small 3x3 products, and without this the compiler keeps
+// many of them as out-of-line calls, which costs about as much as the arithmetic.
+#if defined(__GNUC__) || defined(__clang__)
+#define POSEFUSE_INERTIAL_FLATTEN __attribute__((flatten))
+#else
+#define POSEFUSE_INERTIAL_FLATTEN
+#endif
+
 namespace posefuse {
 
 /// Continuous-time IMU noise figures (the four numbers of a Kalibr / EuRoC
@@ -191,45 +200,26 @@ struct ImuDelta {
 
 namespace detail {
 
-/// Blocks of one mid-point step's transition (see the file comment), shared by
-/// the structured update, the bias Jacobians and the dense reference.
-struct MidpointStep {
-  Eigen::Matrix3d E_T;     ///< \f$ \mathrm{Exp}(\bar\omega\delta t)^\top \f$
-  Eigen::Matrix3d Jr_dt;   ///< \f$ J_r(\bar\omega\delta t)\,\delta t \f$
-  Eigen::Matrix3d U_phi;   ///< \f$ \partial\bar u/\partial\delta\phi \f$
-  Eigen::Matrix3d U_ba;    ///< \f$ \partial\bar u/\partial b_a \f$
-  Eigen::Matrix3d U_bg;    ///< \f$ \partial\bar u/\partial b_g \f$
-  Eigen::Matrix3d R0;      ///< \f$ \Delta R_k \f$
-  Eigen::Matrix3d R1;      ///< \f$ \Delta R_{k+1} \f$
-  Eigen::Matrix3d K;       ///< \f$ R_1[a'_{k+1}]_\times J_r\,\delta t \f$ (gyro noise into \f$ \bar u \f$, ×1/4)
-};
-
-/// Advances (p, R, v) by one mid-point step and returns the step's blocks.
+/// \f$ \mathrm{Exp}(\theta) \f$ as a quaternion and \f$ J_r(\theta) \f$, by
+/// their Taylor series (to \f$ |\theta|^8 \f$, exact in double) for the small
+/// angles of one IMU step, |θ| < 0.05 rad, and by SO3 otherwise. No trigonometric
+/// call on the hot path.
 template <class Lazy = void>
-MidpointStep midpoint_step(const ImuSample& s0, const ImuSample& s1, const ImuBias& bias, double dt,
-                           Eigen::Vector3d& p, SO3d& R, Eigen::Vector3d& v) {
-  MidpointStep st;
-  const Eigen::Vector3d w = 0.5 * (s0.gyro_radps + s1.gyro_radps) - bias.gyro;
-  const Eigen::Vector3d a0 = s0.accel_mps2 - bias.accel;
-  const Eigen::Vector3d a1 = s1.accel_mps2 - bias.accel;
-  const Eigen::Vector3d theta = w * dt;
-  SO3d::Jacobian Jr;
-  const SO3d E = SO3d::exp(theta, &Jr);
-  const SO3d R_next = R.compose(E);
-  st.R0 = R.matrix();
-  st.R1 = R_next.matrix();
-  st.E_T = E.matrix().transpose();
-  st.Jr_dt = Jr * dt;
-  const Eigen::Vector3d u = 0.5 * (st.R0 * a0 + st.R1 * a1);
-  const Eigen::Matrix3d R1_a1x = st.R1 * SO3d::hat(a1);
-  st.U_phi = -0.5 * (st.R0 * SO3d::hat(a0) + R1_a1x * st.E_T);
-  st.U_ba = -0.5 * (st.R0 + st.R1);
-  st.K = R1_a1x * st.Jr_dt;
-  st.U_bg = 0.5 * st.K;
-  p += v * dt + (0.5 * dt * dt) * u;
-  v += u * dt;
-  R = R_next;
-  return st;
+void small_exp(const Eigen::Vector3d& theta, Eigen::Quaterniond& q, Eigen::Matrix3d& Jr) {
+  const double t2 = theta.squaredNorm();
+  if (t2 < 0.05 * 0.05) {
+    const double x2 = t2 / 4.0;  // (θ/2)²
+    const double c = 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0)));
+    const double k = 0.5 * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0 * (1.0 - x2 / 72.0))));
+    q = Eigen::Quaterniond(c, k * theta.x(), k * theta.y(), k * theta.z());
+    // (1 - cos θ)/θ² and (θ - sin θ)/θ³ by their series.
+    const double a = 0.5 * (1.0 - t2 / 12.0 * (1.0 - t2 / 30.0 * (1.0 - t2 / 56.0 * (1.0 - t2 / 90.0))));
+    const double b = (1.0 / 6.0) * (1.0 - t2 / 20.0 * (1.0 - t2 / 42.0 * (1.0 - t2 / 72.0 * (1.0 - t2 / 110.0))));
+    const Eigen::Matrix3d W = SO3d::hat(theta);
+    Jr = Eigen::Matrix3d::Identity() - a * W + b * (W * W);
+  } else {
+    q = SO3d::exp(theta, &Jr).quaternion();
+  }
 }
 
 }  // namespace detail
@@ -283,7 +273,7 @@ class Preintegration {
   }
 
   /// The pre-integrated measurement at the linearisation bias.
-  [[nodiscard]] ImuDelta delta() const { return ImuDelta{delta_p_, delta_R_, delta_v_}; }
+  [[nodiscard]] ImuDelta delta() const { return ImuDelta{delta_p_, rotation(), delta_v_}; }
 
   /// The first-order bias-corrected measurement (Forster eq 44; file comment).
   /// @param[in] bias the bias to correct to; exact at the linearisation bias
@@ -293,13 +283,14 @@ class Preintegration {
   template <class Lazy = void>
   [[nodiscard]] ImuDelta delta(const ImuBias& bias, BiasJacobian* J_d_b = nullptr) const {
     const Eigen::Matrix<double, 6, 1> db = bias.vector() - bias_.vector();
-    const Eigen::Vector3d dphi = J_.block<3, 6>(3, 0) * db;
+    const BiasJacobian J = bias_jacobian();
+    const Eigen::Vector3d dphi = J.block<3, 6>(3, 0) * db;
     SO3d::Jacobian Jr;
-    ImuDelta d{delta_p_ + J_.block<3, 6>(0, 0) * db, delta_R_.plus(dphi, nullptr, &Jr),
-               delta_v_ + J_.block<3, 6>(6, 0) * db};
+    ImuDelta d{delta_p_ + J.block<3, 6>(0, 0) * db, rotation().plus(dphi, nullptr, &Jr),
+               delta_v_ + J.block<3, 6>(6, 0) * db};
     if (J_d_b) {
-      *J_d_b = J_;
-      J_d_b->block<3, 6>(3, 0) = Jr * J_.block<3, 6>(3, 0);
+      *J_d_b = J;
+      J_d_b->block<3, 6>(3, 0) = Jr * J.block<3, 6>(3, 0);
     }
     return d;
   }
@@ -319,6 +310,16 @@ class Preintegration {
     return true;
   }
 
+  /// Starts a new interval (e.g. at the next keyframe) about `bias`; the
+  /// sample storage keeps its capacity, so this does not allocate.
+  /// @throws posefuse::invalid_argument when `bias` is not finite
+  void reset(const ImuBias& bias) {
+    if (!bias.vector().allFinite()) throw invalid_argument("reset: bias is not finite");
+    bias_ = bias;
+    samples_.clear();
+    clear_state();
+  }
+
   /// Re-integrates every stored sample about a new linearisation bias.
   /// @throws posefuse::invalid_argument when `bias` is not finite
   void reintegrate(const ImuBias& bias) {
@@ -328,10 +329,40 @@ class Preintegration {
     for (std::size_t k = 1; k < samples_.size(); ++k) integrate(samples_[k - 1], samples_[k]);
   }
 
-  /// Covariance of \f$ [\delta p, \delta\phi, \delta v, \delta b_a, \delta b_g] \f$ (SI units, rad).
-  [[nodiscard]] const Covariance& covariance() const noexcept { return P_; }
-  /// \f$ \partial[\Delta p, \Delta\phi, \Delta v] / \partial[b_a, b_g] \f$ at the linearisation bias.
-  [[nodiscard]] const BiasJacobian& bias_jacobian() const noexcept { return J_; }
+  /// Covariance of \f$ [\delta p, \delta\phi, \delta v, \delta b_a, \delta b_g] \f$ (SI units,
+  /// rad; δφ the right perturbation of ΔR), exactly symmetric. Assembled from
+  /// the internal blocks on each call (a few hundred flops).
+  template <class Lazy = void>
+  [[nodiscard]] Covariance covariance() const {
+    const M3 Rt = R_.transpose();  // δφ = ΔR^T θ
+    Covariance P = Covariance::Zero();
+    P.block<3, 3>(0, 0) = C_.pp;
+    P.block<3, 3>(0, 3) = C_.pt * R_;
+    P.block<3, 3>(0, 6) = C_.pv;
+    P.block<3, 3>(3, 3) = Rt * C_.tt * R_;
+    P.block<3, 3>(3, 6) = Rt * C_.tv;
+    P.block<3, 3>(6, 6) = C_.vv;
+    P.block<3, 3>(0, 9) = C_.pa;
+    P.block<3, 3>(0, 12) = C_.pg;
+    P.block<3, 3>(3, 12) = Rt * C_.tg;
+    P.block<3, 3>(6, 9) = C_.va;
+    P.block<3, 3>(6, 12) = C_.vg;
+    P.block<3, 3>(9, 9).diagonal().setConstant(C_.da);
+    P.block<3, 3>(12, 12).diagonal().setConstant(C_.dg);
+    P.triangularView<Eigen::StrictlyLower>() = P.transpose();
+    // The rotated diagonal block, symmetric to rounding: make it exact.
+    P.block<3, 3>(3, 3).triangularView<Eigen::StrictlyLower>() =
+        P.block<3, 3>(3, 3).transpose();
+    return P;
+  }
+  /// \f$ \partial[\Delta p, \Delta\phi, \Delta v] / \partial[b_a, b_g] \f$ at the
+  /// linearisation bias (δφ the right perturbation of ΔR).
+  template <class Lazy = void>
+  [[nodiscard]] BiasJacobian bias_jacobian() const {
+    BiasJacobian J;
+    J << Jp_a_, Jp_g_, M3::Zero(), R_.transpose() * Jt_g_, Jv_a_, Jv_g_;
+    return J;
+  }
   /// The linearisation bias \f$ \bar b \f$.
   [[nodiscard]] const ImuBias& bias() const noexcept { return bias_; }
   /// The noise figures.
@@ -354,115 +385,127 @@ class Preintegration {
   }
 
  private:
+  using M3 = Eigen::Matrix3d;
+  // Internally the rotation error is the left perturbation in frame i,
+  // ΔR_true = Exp(θ) ΔR, θ = ΔR δφ: its transition is the identity, the
+  // accelerometer term is a cross product, and F has no E^T blocks. The
+  // covariance is kept as its non-zero 3x3 blocks (upper triangle; Cov(θ, b_a)
+  // stays 0, the bias-bias blocks are d_a I and d_g I) and converted to δφ
+  // when read.
+  struct Blocks {
+    M3 pp, pt, pv, tt, tv, vv;  // Cov of [p, θ, v], upper blocks
+    M3 pa, pg, tg, va, vg;      // Cov([p, θ, v], [b_a, b_g]) without the zero θa block
+    double da, dg;              // bias variances (scalar × I)
+  };
+
   void clear_state() {
     delta_p_.setZero();
     delta_v_.setZero();
-    delta_R_ = SO3d();
-    J_.setZero();
-    P_.setZero();
+    delta_q_.setIdentity();
+    R_.setIdentity();
+    Jp_a_.setZero();
+    Jp_g_.setZero();
+    Jt_g_.setZero();
+    Jv_a_.setZero();
+    Jv_g_.setZero();
+    for (M3* m : {&C_.pp, &C_.pt, &C_.pv, &C_.tt, &C_.tv, &C_.vv, &C_.pa, &C_.pg, &C_.tg, &C_.va,
+                  &C_.vg})
+      m->setZero();
+    C_.da = C_.dg = 0.0;
     dt_s_ = 0.0;
   }
 
-  /// One mid-point step with the structured covariance and Jacobian update.
-  void integrate(const ImuSample& s0, const ImuSample& s1) {
+  [[nodiscard]] SO3d rotation() const { return SO3d(delta_q_); }
+
+  /// One mid-point step (file comment) with the structured covariance and
+  /// Jacobian update, in the left form described at Blocks.
+  POSEFUSE_INERTIAL_FLATTEN void integrate(const ImuSample& s0, const ImuSample& s1) {
     const double dt = seconds_between(s1.t_ns, s0.t_ns);
-    const detail::MidpointStep st =
-        detail::midpoint_step(s0, s1, bias_, dt, delta_p_, delta_R_, delta_v_);
+    const double h = 0.5 * dt * dt;
+    const Eigen::Vector3d a0 = s0.accel_mps2 - bias_.accel;
+    const Eigen::Vector3d a1 = s1.accel_mps2 - bias_.accel;
+    const Eigen::Vector3d w = 0.5 * (s0.gyro_radps + s1.gyro_radps) - bias_.gyro;
+    Eigen::Quaterniond E;
+    M3 Jr;
+    detail::small_exp(w * dt, E, Jr);
+    const M3 R0 = R_;
+    delta_q_ = (delta_q_ * E).normalized();
+    R_ = delta_q_.toRotationMatrix();
+    const Eigen::Vector3d c0 = R0 * a0, c1 = R_ * a1;
+    const Eigen::Vector3d u = 0.5 * (c0 + c1);
+    delta_p_ += dt * delta_v_ + h * u;
+    delta_v_ += dt * u;
     dt_s_ += dt;
-    propagate_jacobian(st, dt);
-    propagate_covariance(st, dt);
-  }
 
-  // J' = F_x J + F_b with F_x = [[I, ½dt²U_φ, dt I], [0, E^T, 0], [0, dt U_φ, I]].
-  void propagate_jacobian(const detail::MidpointStep& st, double dt) {
-    const double h = 0.5 * dt * dt;
-    const Eigen::Matrix<double, 3, 6> Jp = J_.block<3, 6>(0, 0);
-    const Eigen::Matrix<double, 3, 6> Jphi = J_.block<3, 6>(3, 0);
-    const Eigen::Matrix<double, 3, 6> Jv = J_.block<3, 6>(6, 0);
-    Eigen::Matrix<double, 3, 6> Ub;  // ∂ū/∂[b_a, b_g] + U_φ J_φ
-    Ub << st.U_ba, st.U_bg;
-    Ub.noalias() += st.U_phi * Jphi;
-    J_.block<3, 6>(0, 0) = Jp + dt * Jv + h * Ub;
-    J_.block<3, 6>(6, 0) = Jv + dt * Ub;
-    J_.block<3, 6>(3, 0).noalias() = st.E_T * Jphi;
-    J_.block<3, 3>(3, 3) -= st.Jr_dt;
-  }
+    // δu = U_θ θ + U_a δb_a + U_g δb_g, θ' = θ - V δb_g.
+    const M3 Ut = -SO3d::hat(u);
+    const M3 Ua = -0.5 * (R0 + R_);
+    const M3 V = (R_ * Jr) * dt;
+    const M3 C1x = SO3d::hat(c1);
+    const M3 Ug = 0.5 * (C1x * V);
 
-  // P' = F P F^T + G Q G^T by blocks (file comment). Index blocks 0..4 =
-  // p, φ, v, b_a, b_g; the b_a/b_g blocks of P are d_a I and d_g I.
-  void propagate_covariance(const detail::MidpointStep& st, double dt) {
-    using M3 = Eigen::Matrix3d;
-    const double h = 0.5 * dt * dt;
-    const double da = P_(9, 9), dg = P_(12, 12);
-    const auto B = [this](int i, int j) { return P_.block<3, 3>(3 * i, 3 * j); };
-    // Rows of X = F P for p, φ, v; columns p, φ, v, b_a, b_g. With
-    // u_j = U_φ P_φj + U_ba P_aj + U_bg P_gj:  X_p = P_p + dt P_v + h u,
-    // X_φ = E^T P_φ - Jr dt P_g, X_v = P_v + dt u.
-    Eigen::Matrix<double, 9, 15> X;
-    for (int j = 0; j < 5; ++j) {
-      M3 u = st.U_phi * B(1, j);
-      M3 Pg_term;  // Jr dt P_gj
-      if (j < 3) {
-        u.noalias() += st.U_ba * B(3, j) + st.U_bg * B(4, j);
-        Pg_term.noalias() = st.Jr_dt * B(4, j);
-      } else if (j == 3) {
-        u += da * st.U_ba;
-        Pg_term.setZero();
-      } else {
-        u += dg * st.U_bg;
-        Pg_term = dg * st.Jr_dt;
-      }
-      X.block<3, 3>(0, 3 * j) = B(0, j) + dt * B(2, j) + h * u;
-      X.block<3, 3>(3, 3 * j).noalias() = st.E_T * B(1, j);
-      X.block<3, 3>(3, 3 * j) -= Pg_term;
-      X.block<3, 3>(6, 3 * j) = B(2, j) + dt * u;
-    }
-    // P' = X F^T for the p, φ, v rows: P'_ip = X_ip + dt X_iv + h w_i,
-    // P'_iφ = X_iφ E - X_ig (Jr dt)^T, P'_iv = X_iv + dt w_i, with
-    // w_i = X_iφ U_φ^T + X_ia U_ba^T + X_ig U_bg^T; P'_ia = X_ia, P'_ig = X_ig.
-    Eigen::Matrix<double, 9, 9> A;
-    {
-      const Eigen::Matrix<double, 9, 3> Xp = X.block<9, 3>(0, 0), Xphi = X.block<9, 3>(0, 3),
-                                        Xv = X.block<9, 3>(0, 6), Xa = X.block<9, 3>(0, 9),
-                                        Xg = X.block<9, 3>(0, 12);
-      Eigen::Matrix<double, 9, 3> w;
-      w.noalias() = Xphi * st.U_phi.transpose();
-      w.noalias() += Xa * st.U_ba.transpose();
-      w.noalias() += Xg * st.U_bg.transpose();
-      A.block<9, 3>(0, 0) = Xp + dt * Xv + h * w;
-      A.block<9, 3>(0, 3).noalias() = Xphi * st.E_T.transpose();
-      A.block<9, 3>(0, 3).noalias() -= Xg * st.Jr_dt.transpose();
-      A.block<9, 3>(0, 6) = Xv + dt * w;
-    }
-    // Noise, closed form: ū gets −½R0 n_a0 − ½R1 n_a1 + ¼K(n_g0 + n_g1), δφ gets
-    // −½Jr dt (n_g0 + n_g1); each n with variance 2σ²/dt.
+    // Bias Jacobians (J_θa = 0).
+    const M3 Zg = Ut * Jt_g_ + Ug;
+    Jp_a_ += dt * Jv_a_ + h * Ua;
+    Jv_a_ += dt * Ua;
+    Jp_g_ += dt * Jv_g_ + h * Zg;
+    Jv_g_ += dt * Zg;
+    Jt_g_ -= V;
+
+    // X = Cov(x', y) for the blocks needed, with z = δu and w = -V δb_g:
+    // X_p = P_p + dt P_v + h Cov(z, .), X_θ = P_θ + Cov(w, .), X_v = P_v + dt Cov(z, .).
+    Blocks& P = C_;
+    const M3 Czp = Ut * P.pt.transpose() + Ua * P.pa.transpose() + Ug * P.pg.transpose();
+    const M3 Czt = Ut * P.tt + Ug * P.tg.transpose();
+    const M3 Czv = Ut * P.tv + Ua * P.va.transpose() + Ug * P.vg.transpose();
+    const M3 Cza = P.da * Ua;
+    const M3 Czg = Ut * P.tg + P.dg * Ug;
+    const M3 Cwt = -V * P.tg.transpose();
+    const M3 Cwv = -V * P.vg.transpose();
+    const M3 Cwg = -P.dg * V;
+    const M3 Xpp = P.pp + dt * P.pv.transpose() + h * Czp;
+    const M3 Xpt = P.pt + dt * P.tv.transpose() + h * Czt;
+    const M3 Xpv = P.pv + dt * P.vv + h * Czv;
+    const M3 Xpa = P.pa + dt * P.va + h * Cza;
+    const M3 Xpg = P.pg + dt * P.vg + h * Czg;
+    const M3 Xtt = P.tt + Cwt;
+    const M3 Xtv = P.tv + Cwv;
+    const M3 Xtg = P.tg + Cwg;
+    const M3 Xvt = P.tv.transpose() + dt * Czt;
+    const M3 Xvv = P.vv + dt * Czv;
+    const M3 Xva = P.va + dt * Cza;
+    const M3 Xvg = P.vg + dt * Czg;
+    // P' = X (I + L)^T: Z_i = Cov(x'_i, z), W_i = Cov(x'_i, w).
+    const M3 Zp = Xpt * Ut.transpose() + Xpa * Ua.transpose() + Xpg * Ug.transpose();
+    const M3 Zt = Xtt * Ut.transpose() + Xtg * Ug.transpose();
+    const M3 Zv = Xvt * Ut.transpose() + Xva * Ua.transpose() + Xvg * Ug.transpose();
+    // Measurement noise, closed form (file comment), in the left form:
+    // Σθθ = ½c_g V V^T, Σuθ = -¼c_g [c1]x V V^T, Σuu = ½c_a I + c_g/8 [c1]x V V^T [c1]x^T.
     const double ca = 2.0 * noise_.accel_noise_density * noise_.accel_noise_density / dt;
     const double cg = 2.0 * noise_.gyro_noise_density * noise_.gyro_noise_density / dt;
-    M3 S_uu = (cg / 8.0) * (st.K * st.K.transpose());
-    S_uu.diagonal().array() += 0.5 * ca;  // ¼ca (R0 R0^T + R1 R1^T) = ½ca I
-    const M3 S_phiphi = (0.5 * cg) * (st.Jr_dt * st.Jr_dt.transpose());
-    const M3 S_uphi = (-0.25 * cg) * (st.K * st.Jr_dt.transpose());
-    A.block<3, 3>(0, 0) += (h * h) * S_uu;
-    A.block<3, 3>(0, 3) += h * S_uphi;
-    A.block<3, 3>(0, 6) += (h * dt) * S_uu;
-    A.block<3, 3>(3, 3) += S_phiphi;
-    A.block<3, 3>(3, 6) += dt * S_uphi.transpose();
-    A.block<3, 3>(6, 6) += (dt * dt) * S_uu;
-    // Lower blocks of the noise term mirror the upper ones.
-    A.block<3, 3>(3, 0) += h * S_uphi.transpose();
-    A.block<3, 3>(6, 0) += (h * dt) * S_uu;
-    A.block<3, 3>(6, 3) += dt * S_uphi;
-    // Exactly symmetric: the upper triangle, mirrored.
-    P_.block<9, 9>(0, 0).triangularView<Eigen::Upper>() = A;
-    P_.block<9, 9>(0, 0).triangularView<Eigen::StrictlyLower>() = A.transpose();
-    P_.block<9, 6>(0, 9) = X.block<9, 6>(0, 9);
-    P_.block<6, 9>(9, 0) = X.block<9, 6>(0, 9).transpose();
-    const double qa = noise_.accel_random_walk * noise_.accel_random_walk * dt;
-    const double qg = noise_.gyro_random_walk * noise_.gyro_random_walk * dt;
-    for (int k = 0; k < 3; ++k) {
-      P_(9 + k, 9 + k) = da + qa;
-      P_(12 + k, 12 + k) = dg + qg;
-    }
+    const M3 VVt = V * V.transpose();
+    const M3 CVVt = C1x * VVt;
+    M3 Suu = (cg / 8.0) * (CVVt * C1x.transpose());
+    Suu.diagonal().array() += 0.5 * ca;
+    const M3 Sut = (-0.25 * cg) * CVVt;
+    const M3 Stt = (0.5 * cg) * VVt;
+
+    const M3 pp = Xpp + dt * Xpv + h * Zp + (h * h) * Suu;
+    const M3 tt = Xtt - Xtg * V.transpose() + Stt;
+    const M3 vv = Xvv + dt * Zv + (dt * dt) * Suu;
+    P.pp = 0.5 * (pp + pp.transpose());
+    P.pt = Xpt - Xpg * V.transpose() + h * Sut;
+    P.pv = Xpv + dt * Zp + (h * dt) * Suu;
+    P.tt = 0.5 * (tt + tt.transpose());
+    P.tv = Xtv + dt * Zt + dt * Sut.transpose();
+    P.vv = 0.5 * (vv + vv.transpose());
+    P.pa = Xpa;
+    P.pg = Xpg;
+    P.tg = Xtg;
+    P.va = Xva;
+    P.vg = Xvg;
+    P.da += noise_.accel_random_walk * noise_.accel_random_walk * dt;
+    P.dg += noise_.gyro_random_walk * noise_.gyro_random_walk * dt;
   }
 
   ImuNoise noise_;
@@ -470,9 +513,10 @@ class Preintegration {
   PreintegrationOptions options_;
   std::vector<ImuSample> samples_;
   Eigen::Vector3d delta_p_, delta_v_;
-  SO3d delta_R_;
-  BiasJacobian J_;
-  Covariance P_;
+  Eigen::Quaterniond delta_q_;
+  M3 R_;                                     // ΔR as a matrix
+  M3 Jp_a_, Jp_g_, Jt_g_, Jv_a_, Jv_g_;      // bias Jacobians, θ rows in the left form
+  Blocks C_;
   double dt_s_ = 0.0;
 };
 

@@ -1,0 +1,68 @@
+// Seed 003's inertial core: cost per IMU sample of pre-integration with
+// covariance and bias Jacobians — posefuse's structured update against the
+// dense 15x15 F / 15x18 G products of VINS-Mono (same mathematics; a test in
+// tests/inertial checks they agree to 1e-12) — and the other inertial costs.
+//
+// Run (Release; ratios within one binary):
+//   ./build-release/benchmarks/bench_inertial --benchmark_enable_random_interleaving=true \
+//       --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+#include <benchmark/benchmark.h>
+
+#include <cstddef>
+#include <vector>
+
+#include <apps/dense_preintegration.hpp>
+#include <apps/sim/imu.hpp>
+#include <posefuse/inertial/preintegration.hpp>
+
+namespace {
+
+// 1 s of noisy 200 Hz samples; every benchmark integrates them as windows of
+// 200 steps (one keyframe interval), restarting at the end.
+const posefuse::sim::ImuSequence& samples() {
+  static const posefuse::sim::ImuSequence seq = [] {
+    posefuse::sim::ImuSimConfig c;
+    c.noise = posefuse::ImuNoise{};
+    c.initial_bias.accel << 0.1, -0.05, 0.2;
+    c.initial_bias.gyro << 0.01, 0.02, -0.01;
+    return posefuse::sim::simulate_imu(c, 1.0);
+  }();
+  return seq;
+}
+
+void BM_Preintegration_posefuse(benchmark::State& state) {
+  const std::vector<posefuse::ImuSample>& s = samples().samples;
+  posefuse::Preintegration pre(posefuse::ImuNoise{}, posefuse::ImuBias{});
+  std::size_t k = 0;
+  for (auto _ : state) {
+    if (k == s.size()) {
+      pre.reset(posefuse::ImuBias{});
+      k = 0;
+    }
+    benchmark::DoNotOptimize(pre.add(s[k++]));
+    benchmark::ClobberMemory();
+  }
+  benchmark::DoNotOptimize(pre.covariance());
+  state.SetItemsProcessed(state.iterations());
+}
+
+void BM_Preintegration_dense(benchmark::State& state) {
+  const std::vector<posefuse::ImuSample>& s = samples().samples;
+  posefuse::apps::DensePreintegration pre(posefuse::ImuNoise{}, posefuse::ImuBias{});
+  std::size_t k = 0;
+  for (auto _ : state) {
+    if (k == s.size()) {
+      pre = posefuse::apps::DensePreintegration(posefuse::ImuNoise{}, posefuse::ImuBias{});
+      k = 0;
+    }
+    pre.add(s[k++]);
+    benchmark::ClobberMemory();
+  }
+  benchmark::DoNotOptimize(pre.covariance());
+  state.SetItemsProcessed(state.iterations());
+}
+
+}  // namespace
+
+BENCHMARK(BM_Preintegration_posefuse)->Name("BM_Preintegration/posefuse");
+BENCHMARK(BM_Preintegration_dense)->Name("BM_Preintegration/dense");
