@@ -13,6 +13,9 @@
 
 #include <apps/dense_preintegration.hpp>
 #include <apps/sim/imu.hpp>
+#include <array>
+
+#include <posefuse/inertial/alignment.hpp>
 #include <posefuse/inertial/imu_factor.hpp>
 #include <posefuse/inertial/preintegration.hpp>
 
@@ -82,8 +85,35 @@ void BM_ImuFactor_residual_jacobians(benchmark::State& state) {
   }
 }
 
+// One visual-inertial alignment of 10 keyframes 0.3 s apart (gyro bias,
+// re-integration of the 9 intervals, the 54x34 and 54x33 least-squares
+// solves of the refinement, world frame). The pre-integrations are copied
+// in each iteration (the alignment re-integrates them); the copy is timed too.
+void BM_Alignment_10_keyframes(benchmark::State& state) {
+  posefuse::sim::ImuSimConfig c;
+  c.initial_bias.gyro << 0.01, -0.02, 0.005;
+  const posefuse::sim::ImuSequence seq = posefuse::sim::simulate_imu(c, 2.8);
+  const posefuse::SE3d T_b_c(Eigen::Vector3d(0.05, 0, 0), posefuse::SO3d());
+  std::array<posefuse::SE3d, 10> T_c0_c;
+  std::array<posefuse::Preintegration, 9> pre0;
+  const posefuse::SE3d T_c0_w = posefuse::SE3d(seq.truth[0].p_w, seq.truth[0].R_w_b).compose(T_b_c).inverse();
+  for (std::size_t k = 0; k < 10; ++k) {
+    const posefuse::sim::ImuTruth& t = seq.truth[60 * k];
+    const posefuse::SE3d T = T_c0_w.compose(posefuse::SE3d(t.p_w, t.R_w_b).compose(T_b_c));
+    T_c0_c[k] = posefuse::SE3d(T.translation() * 0.37, T.so3());
+    if (k < 9)
+      for (std::size_t i = 60 * k; i <= 60 * (k + 1); ++i) (void)pre0[k].add(seq.samples[i]);
+  }
+  for (auto _ : state) {
+    std::array<posefuse::Preintegration, 9> pre = pre0;
+    const auto r = posefuse::align_visual_inertial<10>(T_c0_c, T_b_c, pre);
+    benchmark::DoNotOptimize(r.scale);
+  }
+}
+
 }  // namespace
 
+BENCHMARK(BM_Alignment_10_keyframes)->Name("BM_Alignment/10_keyframes");
 BENCHMARK(BM_ImuFactor_residual_jacobians)->Name("BM_ImuFactor/residual_jacobians_whitened");
 BENCHMARK(BM_Preintegration_posefuse)->Name("BM_Preintegration/posefuse");
 BENCHMARK(BM_Preintegration_dense)->Name("BM_Preintegration/dense");

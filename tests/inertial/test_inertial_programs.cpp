@@ -45,3 +45,23 @@ TEST_CASE("imu_preintegration_check: EuRoC V1_01_easy", "[inertial][cli][data]")
   CHECK(j["nees_mean"].number() > j["nees_mean_upper"].number());  // over-confident: see README
   CHECK(std::filesystem::file_size(dir.path() / "p.svg") > 1000);
 }
+
+TEST_CASE("vi_alignment_check: usage errors and EuRoC V1_01_easy", "[inertial][cli][data]") {
+  POSEFUSE_REQUIRE_EXAMPLE(exe, "vi_alignment_check");
+  posefuse::test::TempDir dir("vi_check");
+  CHECK(run(exe, "--imu a --groundtruth b --stride 0", dir).status == 2);
+  CHECK(run(exe, "--groundtruth b", dir).status == 2);
+  POSEFUSE_REQUIRE_DATASET(d, "euroc/V1_01_easy");
+  const Run r = run(exe, "--imu '" + (d / "imu0.csv").string() + "' --groundtruth '" +
+                             (d / "groundtruth_20hz.csv").string() + "' --json --svg '" +
+                             (dir.path() / "a.svg").string() + "'",
+                    dir);
+  REQUIRE(r.status == 0);
+  const Json j = Json::parse(r.out);
+  CHECK(j["windows"].number() == 100);
+  // The README's figures (rounded there).
+  CHECK(j["success_rate"].number() == Approx(0.92).margin(1e-9));
+  CHECK(j["scale_error_percent"].number() == Approx(11.9).margin(0.1));
+  CHECK(j["gravity_error_deg"].number() == Approx(0.97).margin(0.01));
+  CHECK(std::filesystem::file_size(dir.path() / "a.svg") > 1000);
+}
