@@ -1,0 +1,578 @@
+#pragma once
+/// @file
+/// IMU pre-integration between two keyframes i and j, in the body frame of i:
+/// mid-point integration, the 15x15 covariance, the bias Jacobians, first-order
+/// bias correction and re-integration.
+///
+/// **Model.** The IMU measures, in its body frame b, the angular rate and the
+/// specific force
+/// \f[ \tilde\omega = \omega + b_g + n_g, \qquad
+///     \tilde a = R_{wb}^\top (a_w - g_w) + b_a + n_a, \f]
+/// with \f$ g_w \f$ the gravity vector (e.g. \f$ (0, 0, -9.81) \f$ m/s² in a z-up world).
+/// Pre-integration (Lupton & Sukkarieh 2012; Forster, Carlone, Dellaert,
+/// Scaramuzza, "On-Manifold Preintegration for Real-Time Visual-Inertial
+/// Odometry", IEEE T-RO 2017, eq 33-35) accumulates the bias-dependent parts
+/// only, so that with \f$ \Delta t_{ij} \f$ the time between the keyframes
+/// \f[ R_j = R_i\,\Delta R_{ij}, \quad
+///     v_j = v_i + g_w \Delta t_{ij} + R_i\,\Delta v_{ij}, \quad
+///     p_j = p_i + v_i \Delta t_{ij} + \tfrac12 g_w \Delta t_{ij}^2 + R_i\,\Delta p_{ij}. \f]
+///
+/// **Mid-point rule** (as VINS-Mono: Qin, Li, Shen, "VINS-Mono", IEEE T-RO 2018,
+/// §IV-B and its discrete propagation). Between samples k and k+1, step
+/// \f$ \delta t \f$, biases \f$ \bar b_a, \bar b_g \f$ (the linearisation point):
+/// \f[ \bar\omega = \tfrac12(\tilde\omega_k + \tilde\omega_{k+1}) - \bar b_g, \quad
+///     \Delta R_{k+1} = \Delta R_k\,\mathrm{Exp}(\bar\omega\,\delta t), \f]
+/// \f[ \bar u = \tfrac12\big(\Delta R_k(\tilde a_k - \bar b_a) + \Delta R_{k+1}(\tilde a_{k+1} - \bar b_a)\big), \quad
+///     \Delta v_{k+1} = \Delta v_k + \bar u\,\delta t, \quad
+///     \Delta p_{k+1} = \Delta p_k + \Delta v_k\,\delta t + \tfrac12 \bar u\,\delta t^2. \f]
+/// (VINS-Mono approximates Exp by the first-order quaternion; here it is exact.)
+///
+/// **Error state** \f$ \delta x = [\delta p, \delta\phi, \delta v, \delta b_a, \delta b_g] \f$
+/// (15, VINS-Mono's order), \f$ \Delta R_{true} = \Delta R\,\mathrm{Exp}(\delta\phi) \f$
+/// (right perturbation, lie/lie.hpp). Its one-step transition F is the exact
+/// linearisation of the mid-point step (the same blocks as VINS-Mono's, with
+/// \f$ \mathrm{Exp}(\bar\omega\delta t)^\top \f$ for \f$ I - [\bar\omega]_\times\delta t \f$
+/// and \f$ J_r(\bar\omega\delta t) \f$ on the gyroscope terms). With
+/// \f$ a'_k = \tilde a_k - \bar b_a \f$, \f$ E = \mathrm{Exp}(\bar\omega\delta t) \f$,
+/// \f$ R_0 = \Delta R_k \f$, \f$ R_1 = \Delta R_{k+1} \f$:
+/// \f[ U_\phi = -\tfrac12\big(R_0[a'_k]_\times + R_1[a'_{k+1}]_\times E^\top\big), \quad
+///     U_{b_a} = -\tfrac12(R_0 + R_1), \quad
+///     U_{b_g} = \tfrac12 R_1[a'_{k+1}]_\times J_r(\bar\omega\delta t)\,\delta t, \f]
+/// \f[ \delta\phi' = E^\top\delta\phi - J_r\,\delta t\,\delta b_g, \quad
+///     \delta v' = \delta v + \delta t\,(U_\phi\delta\phi + U_{b_a}\delta b_a + U_{b_g}\delta b_g), \quad
+///     \delta p' = \delta p + \delta t\,\delta v + \tfrac12\delta t^2 (U_\phi\delta\phi + \dots). \f]
+///
+/// **Noise.** Continuous densities (ImuNoise): white noise \f$ \sigma_a, \sigma_g \f$
+/// on the readings, random walks \f$ \sigma_{b_a}, \sigma_{b_g} \f$ on the biases.
+/// As in VINS-Mono the two end samples of a step carry independent noises
+/// \f$ n_{a,k}, n_{g,k}, n_{a,k+1}, n_{g,k+1} \f$; each gets variance
+/// \f$ 2\sigma^2/\delta t \f$, so that their mean has the variance
+/// \f$ \sigma^2/\delta t \f$ of a continuous white noise averaged over the step
+/// (Forster eq 46's discretisation). They enter like the biases, halved; bias
+/// random walks add \f$ \sigma_b^2\,\delta t\,I \f$. The covariance is
+/// \f$ P' = F P F^\top + G Q G^\top \f$ from \f$ P = 0 \f$ (VINS-Mono eq 11).
+///
+/// **Cost.** The update exploits the structure (most of F is identity or zero,
+/// the bias-bias blocks stay scalar × I, the noise term has the closed form
+/// below); `DensePreintegration` in examples/apps/dense_preintegration.hpp forms the
+/// 15x15 F and 15x18 G and multiplies them (VINS-Mono's way), and a test
+/// checks both agree to 1e-12.
+///
+/// **Bias Jacobians** \f$ J = \partial[\Delta p, \Delta\phi, \Delta v] / \partial[b_a, b_g] \f$
+/// propagate as \f$ J' = F_x J + F_b \f$ from 0 (the top-right 9x6 block of the
+/// product of the F's). First-order correction (Forster eq 44) for a bias
+/// \f$ b = \bar b + \delta b \f$:
+/// \f[ \Delta R(b) = \Delta R\,\mathrm{Exp}(J_{\phi b_g}\delta b_g), \quad
+///     \Delta v(b) = \Delta v + J_{v b_a}\delta b_a + J_{v b_g}\delta b_g, \quad
+///     \Delta p(b) = \Delta p + J_{p b_a}\delta b_a + J_{p b_g}\delta b_g. \f]
+///
+/// **Samples.** Stamps are integer nanoseconds (core/time.hpp). A sample that
+/// is older than the last one (kOutOfOrder), has the same stamp (kRepeated),
+/// comes after a gap above `max_gap_ns` (kGap) or is not finite (kNonFinite)
+/// is reported and not integrated; the state is then untouched.
+///
+/// **Allocation.** Everything is fixed-size. The samples are kept for
+/// re-integration in a std::vector reserved at construction
+/// (`PreintegrationOptions::reserve_samples`); adding a sample allocates only
+/// when that reserve is exceeded.
+
+#include <Eigen/Core>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <posefuse/core/error.hpp>
+#include <posefuse/core/samples.hpp>
+#include <posefuse/core/time.hpp>
+#include <posefuse/lie/so3.hpp>
+
+// Inline every Eigen helper of the per-sample step into it (g++ and clang):
+// the step is ~40 small 3x3 products, and without this the compiler keeps
+// many of them as out-of-line calls, which costs about as much as the arithmetic.
+#if defined(__GNUC__) || defined(__clang__)
+#define POSEFUSE_INERTIAL_FLATTEN __attribute__((flatten))
+#else
+#define POSEFUSE_INERTIAL_FLATTEN
+#endif
+
+namespace posefuse {
+
+/// Continuous-time IMU noise figures (the four numbers of a Kalibr / EuRoC
+/// `imu.yaml`).
+struct ImuNoise {
+  double gyro_noise_density = 1.6968e-4;   ///< \f$ \sigma_g \f$ (rad/s/√Hz)
+  double accel_noise_density = 2.0e-3;     ///< \f$ \sigma_a \f$ (m/s²/√Hz)
+  double gyro_random_walk = 1.9393e-5;     ///< \f$ \sigma_{b_g} \f$ (rad/s²/√Hz)
+  double accel_random_walk = 3.0e-3;       ///< \f$ \sigma_{b_a} \f$ (m/s³/√Hz)
+
+  /// Checks every figure is finite and non-negative.
+  /// @throws posefuse::invalid_argument naming the first bad figure
+  void validate() const {
+    const double v[4] = {gyro_noise_density, accel_noise_density, gyro_random_walk,
+                         accel_random_walk};
+    const char* names[4] = {"gyro_noise_density", "accel_noise_density", "gyro_random_walk",
+                            "accel_random_walk"};
+    for (int i = 0; i < 4; ++i)
+      if (!(std::isfinite(v[i]) && v[i] >= 0.0))
+        throw invalid_argument(std::string("ImuNoise: ") + names[i] +
+                               " must be finite and >= 0, got " + std::to_string(v[i]));
+  }
+};
+
+/// Accelerometer and gyroscope biases in the body frame.
+struct ImuBias {
+  Eigen::Vector3d accel = Eigen::Vector3d::Zero();  ///< \f$ b_a \f$ (m/s²)
+  Eigen::Vector3d gyro = Eigen::Vector3d::Zero();   ///< \f$ b_g \f$ (rad/s)
+  /// As one vector \f$ [b_a, b_g] \f$.
+  [[nodiscard]] Eigen::Matrix<double, 6, 1> vector() const {
+    Eigen::Matrix<double, 6, 1> b;
+    b << accel, gyro;
+    return b;
+  }
+  /// From one vector \f$ [b_a, b_g] \f$.
+  [[nodiscard]] static ImuBias from_vector(const Eigen::Matrix<double, 6, 1>& b) {
+    return ImuBias{b.head<3>(), b.tail<3>()};
+  }
+};
+
+/// Configuration of a Preintegration.
+struct PreintegrationOptions {
+  /// Largest accepted time between consecutive samples (ns); a larger gap is kGap.
+  std::int64_t max_gap_ns = 50'000'000;
+  /// update_bias() re-integrates when \f$ |\delta b_a| \f$ exceeds this (m/s²) ...
+  double reintegrate_accel_threshold = 0.1;
+  /// ... or when \f$ |\delta b_g| \f$ exceeds this (rad/s).
+  double reintegrate_gyro_threshold = 0.01;
+  /// Samples reserved for re-integration (no allocation per sample below this).
+  std::size_t reserve_samples = 1024;
+};
+
+/// Outcome of adding one IMU sample.
+enum class ImuStatus {
+  kApplied,        ///< integrated
+  kStarted,        ///< the first sample: it starts the interval, nothing to integrate yet
+  kOutOfOrder,     ///< stamp before the last sample's: not integrated
+  kRepeated,       ///< stamp equal to the last sample's: not integrated
+  kGap,            ///< time since the last sample above max_gap_ns: not integrated
+  kNonFinite,      ///< a reading is NaN or infinite: not integrated
+  kOutOfRange,     ///< (preintegrate) the samples do not cover the requested interval
+};
+
+/// Human-readable name of an ImuStatus.
+[[nodiscard]] constexpr const char* to_string(ImuStatus s) noexcept {
+  switch (s) {
+    case ImuStatus::kApplied: return "applied";
+    case ImuStatus::kStarted: return "started";
+    case ImuStatus::kOutOfOrder: return "out of order";
+    case ImuStatus::kRepeated: return "repeated stamp";
+    case ImuStatus::kGap: return "gap above the limit";
+    case ImuStatus::kNonFinite: return "non-finite reading";
+    case ImuStatus::kOutOfRange: return "samples do not cover the interval";
+  }
+  return "unknown";
+}
+
+/// The pre-integrated measurement \f$ (\Delta p, \Delta R, \Delta v) \f$, a
+/// posefuse::Manifold of dimension 9 with tangent \f$ [\delta p, \delta\phi, \delta v] \f$
+/// (\f$ \Delta R \oplus \delta\phi = \Delta R\,\mathrm{Exp}(\delta\phi) \f$; p and v Euclidean).
+struct ImuDelta {
+  using Scalar = double;             ///< scalar type
+  static constexpr int Dim = 9;      ///< tangent dimension
+  using Tangent = Eigen::Matrix<double, 9, 1>;  ///< [δp, δφ, δv]
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();  ///< \f$ \Delta p_{ij} \f$ (m, frame i)
+  SO3d R;                                       ///< \f$ \Delta R_{ij} = R_i^\top R_j \f$
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();  ///< \f$ \Delta v_{ij} \f$ (m/s, frame i)
+
+  /// \f$ x \oplus d \f$.
+  [[nodiscard]] ImuDelta plus(const Tangent& d) const {
+    return ImuDelta{p + d.segment<3>(0), R.plus(d.segment<3>(3)), v + d.segment<3>(6)};
+  }
+  /// \f$ y \ominus x \f$ (this = y).
+  [[nodiscard]] Tangent minus(const ImuDelta& x) const {
+    Tangent d;
+    d << p - x.p, R.minus(x.R), v - x.v;
+    return d;
+  }
+};
+
+namespace detail {
+
+/// \f$ \mathrm{Exp}(\theta) \f$ as a quaternion and \f$ J_r(\theta) \f$, by
+/// their Taylor series (to \f$ |\theta|^8 \f$, exact in double) for the small
+/// angles of one IMU step, |θ| < 0.05 rad, and by SO3 otherwise. No trigonometric
+/// call on the hot path.
+template <class Lazy = void>
+void small_exp(const Eigen::Vector3d& theta, Eigen::Quaterniond& q, Eigen::Matrix3d& Jr) {
+  const double t2 = theta.squaredNorm();
+  if (t2 < 0.05 * 0.05) {
+    const double x2 = t2 / 4.0;  // (θ/2)²
+    const double c = 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0)));
+    const double k = 0.5 * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0 * (1.0 - x2 / 72.0))));
+    q = Eigen::Quaterniond(c, k * theta.x(), k * theta.y(), k * theta.z());
+    // (1 - cos θ)/θ² and (θ - sin θ)/θ³ by their series.
+    const double a = 0.5 * (1.0 - t2 / 12.0 * (1.0 - t2 / 30.0 * (1.0 - t2 / 56.0 * (1.0 - t2 / 90.0))));
+    const double b = (1.0 / 6.0) * (1.0 - t2 / 20.0 * (1.0 - t2 / 42.0 * (1.0 - t2 / 72.0 * (1.0 - t2 / 110.0))));
+    const Eigen::Matrix3d W = SO3d::hat(theta);
+    Jr = Eigen::Matrix3d::Identity() - a * W + b * (W * W);
+  } else {
+    q = SO3d::exp(theta, &Jr).quaternion();
+  }
+}
+
+}  // namespace detail
+
+/// IMU pre-integration between two keyframes (see the file comment).
+///
+/// Usage: construct with the noise and the bias to linearise about, `add`
+/// every sample from the one at keyframe i to the one at keyframe j (the
+/// first returns kStarted), then read `delta()`, `covariance()`,
+/// `bias_jacobian()`, or `delta(bias)` for another bias.
+class Preintegration {
+ public:
+  using Covariance = Eigen::Matrix<double, 15, 15>;  ///< over [δp, δφ, δv, δb_a, δb_g]
+  using BiasJacobian = Eigen::Matrix<double, 9, 6>;  ///< ∂[Δp, Δφ, Δv] / ∂[b_a, b_g]
+
+  /// @param[in] noise continuous-time noise figures
+  /// @param[in] bias linearisation bias \f$ \bar b \f$
+  /// @param[in] options gap limit, re-integration thresholds, sample reserve
+  /// @throws posefuse::invalid_argument for bad noise figures, a non-finite
+  ///         bias, a non-positive max_gap_ns or negative/non-finite thresholds
+  explicit Preintegration(const ImuNoise& noise = {}, const ImuBias& bias = {},
+                          const PreintegrationOptions& options = {})
+      : noise_(noise), bias_(bias), options_(options) {
+    noise.validate();
+    if (!bias.vector().allFinite()) throw invalid_argument("Preintegration: bias is not finite");
+    if (options.max_gap_ns <= 0) throw invalid_argument("Preintegration: max_gap_ns must be > 0");
+    if (!(options.reintegrate_accel_threshold >= 0 && options.reintegrate_gyro_threshold >= 0 &&
+          std::isfinite(options.reintegrate_accel_threshold) &&
+          std::isfinite(options.reintegrate_gyro_threshold)))
+      throw invalid_argument("Preintegration: re-integration thresholds must be finite and >= 0");
+    samples_.reserve(options.reserve_samples);
+    clear_state();
+  }
+
+  /// Adds the next sample: the first starts the interval (kStarted), every
+  /// later one integrates from the previous sample to it (kApplied).
+  /// Anything else leaves the pre-integration untouched (see ImuStatus).
+  [[nodiscard]] ImuStatus add(const ImuSample& s) {
+    if (!s.accel_mps2.allFinite() || !s.gyro_radps.allFinite()) return ImuStatus::kNonFinite;
+    if (samples_.empty()) {
+      samples_.push_back(s);
+      return ImuStatus::kStarted;
+    }
+    const ImuSample& last = samples_.back();
+    if (s.t_ns < last.t_ns) return ImuStatus::kOutOfOrder;
+    if (s.t_ns == last.t_ns) return ImuStatus::kRepeated;
+    if (s.t_ns - last.t_ns > options_.max_gap_ns) return ImuStatus::kGap;  // no overflow: s > last
+    integrate(last, s);
+    samples_.push_back(s);
+    return ImuStatus::kApplied;
+  }
+
+  /// The pre-integrated measurement at the linearisation bias.
+  [[nodiscard]] ImuDelta delta() const { return ImuDelta{delta_p_, rotation(), delta_v_}; }
+
+  /// The first-order bias-corrected measurement (Forster eq 44; file comment).
+  /// @param[in] bias the bias to correct to; exact at the linearisation bias
+  /// @param[out] J_d_b if not null, \f$ \partial\,\Delta(b) \ominus \Delta(\bar b) / \partial b \f$
+  ///             (9x6; equal to bias_jacobian() except the rotation rows,
+  ///             \f$ J_r(J_{\phi b_g}\delta b_g) J_{\phi b_g} \f$)
+  template <class Lazy = void>
+  [[nodiscard]] ImuDelta delta(const ImuBias& bias, BiasJacobian* J_d_b = nullptr) const {
+    const Eigen::Matrix<double, 6, 1> db = bias.vector() - bias_.vector();
+    const BiasJacobian J = bias_jacobian();
+    const Eigen::Vector3d dphi = J.block<3, 6>(3, 0) * db;
+    SO3d::Jacobian Jr;
+    ImuDelta d{delta_p_ + J.block<3, 6>(0, 0) * db, rotation().plus(dphi, nullptr, &Jr),
+               delta_v_ + J.block<3, 6>(6, 0) * db};
+    if (J_d_b) {
+      *J_d_b = J;
+      J_d_b->block<3, 6>(3, 0) = Jr * J.block<3, 6>(3, 0);
+    }
+    return d;
+  }
+
+  /// Moves the linearisation point to `bias`: re-integrates every stored
+  /// sample when the change exceeds a threshold of PreintegrationOptions,
+  /// else keeps the current integration (delta(bias) then corrects to first order).
+  /// @return true when it re-integrated
+  /// @throws posefuse::invalid_argument when `bias` is not finite
+  bool update_bias(const ImuBias& bias) {
+    if (!bias.vector().allFinite()) throw invalid_argument("update_bias: bias is not finite");
+    const double da = (bias.accel - bias_.accel).norm();
+    const double dg = (bias.gyro - bias_.gyro).norm();
+    if (da <= options_.reintegrate_accel_threshold && dg <= options_.reintegrate_gyro_threshold)
+      return false;
+    reintegrate(bias);
+    return true;
+  }
+
+  /// Starts a new interval (e.g. at the next keyframe) about `bias`; the
+  /// sample storage keeps its capacity, so this does not allocate.
+  /// @throws posefuse::invalid_argument when `bias` is not finite
+  void reset(const ImuBias& bias) {
+    if (!bias.vector().allFinite()) throw invalid_argument("reset: bias is not finite");
+    bias_ = bias;
+    samples_.clear();
+    clear_state();
+  }
+
+  /// Re-integrates every stored sample about a new linearisation bias.
+  /// @throws posefuse::invalid_argument when `bias` is not finite
+  void reintegrate(const ImuBias& bias) {
+    if (!bias.vector().allFinite()) throw invalid_argument("reintegrate: bias is not finite");
+    bias_ = bias;
+    clear_state();
+    for (std::size_t k = 1; k < samples_.size(); ++k) integrate(samples_[k - 1], samples_[k]);
+  }
+
+  /// Covariance of \f$ [\delta p, \delta\phi, \delta v, \delta b_a, \delta b_g] \f$ (SI units,
+  /// rad; δφ the right perturbation of ΔR), exactly symmetric. Assembled from
+  /// the internal blocks on each call (a few hundred flops).
+  template <class Lazy = void>
+  [[nodiscard]] Covariance covariance() const {
+    const M3 Rt = R_.transpose();  // δφ = ΔR^T θ
+    Covariance P = Covariance::Zero();
+    P.block<3, 3>(0, 0) = C_.pp;
+    P.block<3, 3>(0, 3) = C_.pt * R_;
+    P.block<3, 3>(0, 6) = C_.pv;
+    P.block<3, 3>(3, 3) = Rt * C_.tt * R_;
+    P.block<3, 3>(3, 6) = Rt * C_.tv;
+    P.block<3, 3>(6, 6) = C_.vv;
+    P.block<3, 3>(0, 9) = C_.pa;
+    P.block<3, 3>(0, 12) = C_.pg;
+    P.block<3, 3>(3, 12) = Rt * C_.tg;
+    P.block<3, 3>(6, 9) = C_.va;
+    P.block<3, 3>(6, 12) = C_.vg;
+    P.block<3, 3>(9, 9).diagonal().setConstant(C_.da);
+    P.block<3, 3>(12, 12).diagonal().setConstant(C_.dg);
+    P.triangularView<Eigen::StrictlyLower>() = P.transpose();
+    // The rotated diagonal block, symmetric to rounding: make it exact.
+    P.block<3, 3>(3, 3).triangularView<Eigen::StrictlyLower>() =
+        P.block<3, 3>(3, 3).transpose();
+    return P;
+  }
+  /// \f$ \partial[\Delta p, \Delta\phi, \Delta v] / \partial[b_a, b_g] \f$ at the
+  /// linearisation bias (δφ the right perturbation of ΔR).
+  template <class Lazy = void>
+  [[nodiscard]] BiasJacobian bias_jacobian() const {
+    BiasJacobian J;
+    J << Jp_a_, Jp_g_, M3::Zero(), R_.transpose() * Jt_g_, Jv_a_, Jv_g_;
+    return J;
+  }
+  /// The linearisation bias \f$ \bar b \f$.
+  [[nodiscard]] const ImuBias& bias() const noexcept { return bias_; }
+  /// The noise figures.
+  [[nodiscard]] const ImuNoise& noise() const noexcept { return noise_; }
+  /// The options.
+  [[nodiscard]] const PreintegrationOptions& options() const noexcept { return options_; }
+  /// \f$ \Delta t_{ij} \f$ (s): sum of the integrated steps.
+  [[nodiscard]] double dt_s() const noexcept { return dt_s_; }
+  /// Number of stored samples (integrated steps + 1, or 0).
+  [[nodiscard]] std::size_t sample_count() const noexcept { return samples_.size(); }
+  /// The stored samples.
+  [[nodiscard]] std::span<const ImuSample> samples() const noexcept { return samples_; }
+  /// Stamp of the first sample (keyframe i), 0 before any.
+  [[nodiscard]] std::int64_t start_t_ns() const noexcept {
+    return samples_.empty() ? 0 : samples_.front().t_ns;
+  }
+  /// Stamp of the last sample, 0 before any.
+  [[nodiscard]] std::int64_t end_t_ns() const noexcept {
+    return samples_.empty() ? 0 : samples_.back().t_ns;
+  }
+
+ private:
+  using M3 = Eigen::Matrix3d;
+  // Internally the rotation error is the left perturbation in frame i,
+  // ΔR_true = Exp(θ) ΔR, θ = ΔR δφ: its transition is the identity, the
+  // accelerometer term is a cross product, and F has no E^T blocks. The
+  // covariance is kept as its non-zero 3x3 blocks (upper triangle; Cov(θ, b_a)
+  // stays 0, the bias-bias blocks are d_a I and d_g I) and converted to δφ
+  // when read.
+  struct Blocks {
+    M3 pp, pt, pv, tt, tv, vv;  // Cov of [p, θ, v], upper blocks
+    M3 pa, pg, tg, va, vg;      // Cov([p, θ, v], [b_a, b_g]) without the zero θa block
+    double da, dg;              // bias variances (scalar × I)
+  };
+
+  void clear_state() {
+    delta_p_.setZero();
+    delta_v_.setZero();
+    delta_q_.setIdentity();
+    R_.setIdentity();
+    Jp_a_.setZero();
+    Jp_g_.setZero();
+    Jt_g_.setZero();
+    Jv_a_.setZero();
+    Jv_g_.setZero();
+    for (M3* m : {&C_.pp, &C_.pt, &C_.pv, &C_.tt, &C_.tv, &C_.vv, &C_.pa, &C_.pg, &C_.tg, &C_.va,
+                  &C_.vg})
+      m->setZero();
+    C_.da = C_.dg = 0.0;
+    dt_s_ = 0.0;
+  }
+
+  [[nodiscard]] SO3d rotation() const { return SO3d(delta_q_); }
+
+  /// One mid-point step (file comment) with the structured covariance and
+  /// Jacobian update, in the left form described at Blocks.
+  POSEFUSE_INERTIAL_FLATTEN void integrate(const ImuSample& s0, const ImuSample& s1) {
+    const double dt = seconds_between(s1.t_ns, s0.t_ns);
+    const double h = 0.5 * dt * dt;
+    const Eigen::Vector3d a0 = s0.accel_mps2 - bias_.accel;
+    const Eigen::Vector3d a1 = s1.accel_mps2 - bias_.accel;
+    const Eigen::Vector3d w = 0.5 * (s0.gyro_radps + s1.gyro_radps) - bias_.gyro;
+    Eigen::Quaterniond E;
+    M3 Jr;
+    detail::small_exp(w * dt, E, Jr);
+    const M3 R0 = R_;
+    delta_q_ = (delta_q_ * E).normalized();
+    R_ = delta_q_.toRotationMatrix();
+    const Eigen::Vector3d c0 = R0 * a0, c1 = R_ * a1;
+    const Eigen::Vector3d u = 0.5 * (c0 + c1);
+    delta_p_ += dt * delta_v_ + h * u;
+    delta_v_ += dt * u;
+    dt_s_ += dt;
+
+    // δu = U_θ θ + U_a δb_a + U_g δb_g, θ' = θ - V δb_g.
+    const M3 Ut = -SO3d::hat(u);
+    const M3 Ua = -0.5 * (R0 + R_);
+    const M3 V = (R_ * Jr) * dt;
+    const M3 C1x = SO3d::hat(c1);
+    const M3 Ug = 0.5 * (C1x * V);
+
+    // Bias Jacobians (J_θa = 0).
+    const M3 Zg = Ut * Jt_g_ + Ug;
+    Jp_a_ += dt * Jv_a_ + h * Ua;
+    Jv_a_ += dt * Ua;
+    Jp_g_ += dt * Jv_g_ + h * Zg;
+    Jv_g_ += dt * Zg;
+    Jt_g_ -= V;
+
+    // X = Cov(x', y) for the blocks needed, with z = δu and w = -V δb_g:
+    // X_p = P_p + dt P_v + h Cov(z, .), X_θ = P_θ + Cov(w, .), X_v = P_v + dt Cov(z, .).
+    Blocks& P = C_;
+    const M3 Czp = Ut * P.pt.transpose() + Ua * P.pa.transpose() + Ug * P.pg.transpose();
+    const M3 Czt = Ut * P.tt + Ug * P.tg.transpose();
+    const M3 Czv = Ut * P.tv + Ua * P.va.transpose() + Ug * P.vg.transpose();
+    const M3 Cza = P.da * Ua;
+    const M3 Czg = Ut * P.tg + P.dg * Ug;
+    const M3 Cwt = -V * P.tg.transpose();
+    const M3 Cwv = -V * P.vg.transpose();
+    const M3 Cwg = -P.dg * V;
+    const M3 Xpp = P.pp + dt * P.pv.transpose() + h * Czp;
+    const M3 Xpt = P.pt + dt * P.tv.transpose() + h * Czt;
+    const M3 Xpv = P.pv + dt * P.vv + h * Czv;
+    const M3 Xpa = P.pa + dt * P.va + h * Cza;
+    const M3 Xpg = P.pg + dt * P.vg + h * Czg;
+    const M3 Xtt = P.tt + Cwt;
+    const M3 Xtv = P.tv + Cwv;
+    const M3 Xtg = P.tg + Cwg;
+    const M3 Xvt = P.tv.transpose() + dt * Czt;
+    const M3 Xvv = P.vv + dt * Czv;
+    const M3 Xva = P.va + dt * Cza;
+    const M3 Xvg = P.vg + dt * Czg;
+    // P' = X (I + L)^T: Z_i = Cov(x'_i, z), W_i = Cov(x'_i, w).
+    const M3 Zp = Xpt * Ut.transpose() + Xpa * Ua.transpose() + Xpg * Ug.transpose();
+    const M3 Zt = Xtt * Ut.transpose() + Xtg * Ug.transpose();
+    const M3 Zv = Xvt * Ut.transpose() + Xva * Ua.transpose() + Xvg * Ug.transpose();
+    // Measurement noise, closed form (file comment), in the left form:
+    // Σθθ = ½c_g V V^T, Σuθ = -¼c_g [c1]x V V^T, Σuu = ½c_a I + c_g/8 [c1]x V V^T [c1]x^T.
+    const double ca = 2.0 * noise_.accel_noise_density * noise_.accel_noise_density / dt;
+    const double cg = 2.0 * noise_.gyro_noise_density * noise_.gyro_noise_density / dt;
+    const M3 VVt = V * V.transpose();
+    const M3 CVVt = C1x * VVt;
+    M3 Suu = (cg / 8.0) * (CVVt * C1x.transpose());
+    Suu.diagonal().array() += 0.5 * ca;
+    const M3 Sut = (-0.25 * cg) * CVVt;
+    const M3 Stt = (0.5 * cg) * VVt;
+
+    const M3 pp = Xpp + dt * Xpv + h * Zp + (h * h) * Suu;
+    const M3 tt = Xtt - Xtg * V.transpose() + Stt;
+    const M3 vv = Xvv + dt * Zv + (dt * dt) * Suu;
+    P.pp = 0.5 * (pp + pp.transpose());
+    P.pt = Xpt - Xpg * V.transpose() + h * Sut;
+    P.pv = Xpv + dt * Zp + (h * dt) * Suu;
+    P.tt = 0.5 * (tt + tt.transpose());
+    P.tv = Xtv + dt * Zt + dt * Sut.transpose();
+    P.vv = 0.5 * (vv + vv.transpose());
+    P.pa = Xpa;
+    P.pg = Xpg;
+    P.tg = Xtg;
+    P.va = Xva;
+    P.vg = Xvg;
+    P.da += noise_.accel_random_walk * noise_.accel_random_walk * dt;
+    P.dg += noise_.gyro_random_walk * noise_.gyro_random_walk * dt;
+  }
+
+  ImuNoise noise_;
+  ImuBias bias_;
+  PreintegrationOptions options_;
+  std::vector<ImuSample> samples_;
+  Eigen::Vector3d delta_p_, delta_v_;
+  Eigen::Quaterniond delta_q_;
+  M3 R_;                                     // ΔR as a matrix
+  M3 Jp_a_, Jp_g_, Jt_g_, Jv_a_, Jv_g_;      // bias Jacobians, θ rows in the left form
+  Blocks C_;
+  double dt_s_ = 0.0;
+};
+
+/// The sample at `t_ns` linearly interpolated between `a` and `b` (readings
+/// only; the magnetometer is interpolated too).
+/// @pre a.t_ns < b.t_ns and a.t_ns <= t_ns <= b.t_ns
+[[nodiscard]] inline ImuSample interpolate_imu(const ImuSample& a, const ImuSample& b,
+                                               std::int64_t t_ns) noexcept {
+  const double s = seconds_between(t_ns, a.t_ns) / seconds_between(b.t_ns, a.t_ns);
+  ImuSample out;
+  out.t_ns = t_ns;
+  out.accel_mps2 = a.accel_mps2 + s * (b.accel_mps2 - a.accel_mps2);
+  out.gyro_radps = a.gyro_radps + s * (b.gyro_radps - a.gyro_radps);
+  out.mag_uT = a.mag_uT + s * (b.mag_uT - a.mag_uT);
+  return out;
+}
+
+/// Pre-integrates a time-ordered sample stream between two arbitrary stamps:
+/// the boundary samples at `t0_ns` and `t1_ns` are linearly interpolated
+/// from the samples around them (used as they are when a stamp matches).
+/// @param[in] samples time-ordered samples covering [t0_ns, t1_ns]
+/// @param[in] t0_ns, t1_ns the keyframe stamps, t0_ns < t1_ns
+/// @param[out] out a fresh Preintegration (its noise, bias and options are kept)
+/// @return kApplied, kOutOfRange when the samples do not cover the interval
+///         (or t1_ns <= t0_ns), or the first non-applied status of a sample
+///         inside it (out is then partial: do not use it)
+template <class Lazy = void>
+[[nodiscard]] ImuStatus preintegrate(std::span<const ImuSample> samples, std::int64_t t0_ns,
+                                     std::int64_t t1_ns, Preintegration& out) {
+  out = Preintegration(out.noise(), out.bias(), out.options());
+  if (!(t0_ns < t1_ns) || samples.empty() || samples.front().t_ns > t0_ns ||
+      samples.back().t_ns < t1_ns)
+    return ImuStatus::kOutOfRange;
+  // First sample with t > t0 (binary search; the stream must be ordered, which add() checks).
+  std::size_t lo = 0, hi = samples.size();
+  while (lo < hi) {
+    const std::size_t mid = lo + (hi - lo) / 2;
+    if (samples[mid].t_ns <= t0_ns) lo = mid + 1; else hi = mid;
+  }
+  const std::size_t k0 = lo;  // samples[k0 - 1].t_ns <= t0 < samples[k0].t_ns
+  const ImuSample& before = samples[k0 - 1];
+  const ImuSample first =
+      before.t_ns == t0_ns ? before : interpolate_imu(before, samples[k0], t0_ns);
+  ImuStatus st = out.add(first);
+  if (st != ImuStatus::kStarted) return st;
+  for (std::size_t k = k0; k < samples.size(); ++k) {
+    const ImuSample& s = samples[k];
+    if (s.t_ns >= t1_ns) {
+      const ImuSample last = s.t_ns == t1_ns ? s : interpolate_imu(samples[k - 1], s, t1_ns);
+      st = out.add(last);
+      return st;
+    }
+    st = out.add(s);
+    if (st != ImuStatus::kApplied) return st;
+  }
+  return ImuStatus::kOutOfRange;  // unreachable: samples.back().t_ns >= t1_ns
+}
+
+}  // namespace posefuse
