@@ -66,6 +66,9 @@ struct Options {
   std::filesystem::path groundtruth, estimate;
   std::optional<std::filesystem::path> times, save_results, plot;
   posefuse::Plane plot_mode = posefuse::Plane::kXY;
+  // Given by --format / --groundtruth-format / --estimate-format, or
+  // detected from the file's content (resolve_formats) when not given.
+  std::optional<posefuse::Format> ref_format_given, est_format_given;
   posefuse::Format ref_format = posefuse::Format::kKitti;
   posefuse::Format est_format = posefuse::Format::kKitti;
   posefuse::DuplicateStamps duplicates = posefuse::DuplicateStamps::kFirst;
@@ -101,15 +104,22 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   bool all_pairs = false, pairs_from_reference = false;
   double delta_tol = o.rpe.delta_tol;
   const auto format_flag = [](std::optional<posefuse::Format>& f) {
-    return [&f](std::string_view v) { f = posefuse::parse_format(v); };
+    return [&f](std::string_view v) {
+      if (v == "auto") {
+        f.reset();
+      } else {
+        f = posefuse::parse_format(v);
+      }
+    };
   };
   apps::Parser cli(cmd.program, "--groundtruth REF --estimate EST [options]",
                    "Absolute (APE) or relative (RPE) pose error of EST against REF, as evo_ape / "
                    "evo_rpe.");
   cli.path({.name = "--groundtruth", .value = "FILE", .help = "reference trajectory (required)"}, ref);
   cli.path({.name = "--estimate", .value = "FILE", .help = "estimated trajectory (required)"}, est);
-  cli.custom({.name = "--format", .value = "kitti|tum", .help = "format of both files",
-              .default_text = "kitti"},
+  cli.custom({.name = "--format", .value = "auto|kitti|tum|euroc",
+              .help = "format of both files (auto: told from the content, printed)",
+              .default_text = "auto"},
              format_flag(format));
   cli.custom({.name = "--groundtruth-format", .value = "F",
               .help = "format of REF only (overrides --format)"},
@@ -201,13 +211,8 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   if (!ref || !est) throw apps::usage_error("--groundtruth and --estimate are required");
   o.groundtruth = *ref;
   o.estimate = *est;
-  o.ref_format = ref_format.value_or(format.value_or(posefuse::Format::kKitti));
-  o.est_format = est_format.value_or(format.value_or(posefuse::Format::kKitti));
-  const bool any_kitti =
-      o.ref_format == posefuse::Format::kKitti || o.est_format == posefuse::Format::kKitti;
-  if (o.times && !any_kitti) throw apps::usage_error("--times only applies to KITTI files");
-  if (o.ref_format != o.est_format && !o.times)
-    throw apps::usage_error("comparing a KITTI with a TUM file needs --times for the KITTI one");
+  o.ref_format_given = ref_format ? ref_format : format;
+  o.est_format_given = est_format ? est_format : format;
   o.rpe.all_pairs = all_pairs;
   o.rpe.delta_tol = delta_tol;
   o.rpe.pairs_from_reference = pairs_from_reference;
@@ -228,12 +233,6 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
     throw apps::usage_error("--t-start is after --t-end");
   o.t_start = t_start;
   o.t_end = t_end;
-  const bool frame_by_frame = o.ref_format == posefuse::Format::kKitti &&
-                              o.est_format == posefuse::Format::kKitti && !o.times;
-  if (frame_by_frame && (o.motion_filter || o.t_start || o.t_end || o.t_offset != 0.0))
-    throw apps::usage_error(
-        "--motion-filter, --t-start, --t-end and --t-offset need timestamps: give --times "
-        "(KITTI files without it are compared frame by frame)");
   o.rpe.alignment = o.align.alignment;
   o.rpe.n_to_align = o.align.n_to_align;
   o.rpe.align_origin = o.align.align_origin;
@@ -258,6 +257,8 @@ Loaded load(const std::filesystem::path& file, posefuse::Format format,
   Loaded out;
   if (format == posefuse::Format::kKitti) {
     out.trajectory = posefuse::read_kitti(file, times, options, &report);
+  } else if (format == posefuse::Format::kEuroc) {
+    out.trajectory = posefuse::read_euroc_groundtruth(file, options, &report).trajectory;
   } else if (allow_covariance) {
     posefuse::TumWithCovariance t = posefuse::read_tum_with_covariance(file, options, &report);
     out.trajectory = std::move(t.trajectory);
@@ -330,6 +331,11 @@ void print_table(const Options& o, const posefuse::MetricResult& r,
                 o.rpe.all_pairs ? ", all pairs" : "");
   }
   std::printf("\n");
+  std::printf("files  groundtruth %s (%s), estimate %s (%s)\n",
+              std::string(posefuse::to_string(o.ref_format)).c_str(),
+              o.ref_format_given ? "given" : "detected",
+              std::string(posefuse::to_string(o.est_format)).c_str(),
+              o.est_format_given ? "given" : "detected");
   std::printf("pairs  %11zu\n", r.stats.count);
   if (!o.metric_rpe && (r.stats.count != n_ref || r.stats.count != n_est)) {
     std::printf("poses  %zu reference, %zu estimate\n", n_ref, n_est);
@@ -355,6 +361,9 @@ void write_summary(apps::JsonWriter& j, const Options& o, const posefuse::Metric
                    const std::optional<posefuse::NeesResult>& nees) {
   const posefuse::Statistics& s = r.stats;
   j.member("metric", o.metric_rpe ? "rpe" : "ape")
+      .member("groundtruth_format", posefuse::to_string(o.ref_format))
+      .member("estimate_format", posefuse::to_string(o.est_format))
+      .member("formats_detected", !o.ref_format_given || !o.est_format_given)
       .member("pose_relation", relation_name(o.relation))
       .member("unit", posefuse::unit_of(o.relation))
       .member("alignment", alignment_name(o))
@@ -392,8 +401,6 @@ std::string results_json(const Options& o, const posefuse::MetricResult& r,
   write_summary(j, o, r, nees);
   j.key("options").begin_object();
   j.member("groundtruth", o.groundtruth.string()).member("estimate", o.estimate.string());
-  j.member("groundtruth_format", posefuse::to_string(o.ref_format))
-      .member("estimate_format", posefuse::to_string(o.est_format));
   j.member("duplicates", posefuse::to_string(o.duplicates));
   j.member("n_to_align", o.align.n_to_align);
   j.member("project_to_plane",
@@ -536,7 +543,31 @@ posefuse::Trajectory thin(const posefuse::Trajectory& traj, const Options& o) {
   return out;
 }
 
-int run(const Options& o) {
+/// Fills in the formats not given on the command line from the files'
+/// content, then checks what depends on them (usage errors, exit 2).
+Options resolve_formats(Options o) {
+  o.ref_format = o.ref_format_given ? *o.ref_format_given : posefuse::detect_format(o.groundtruth);
+  o.est_format = o.est_format_given ? *o.est_format_given : posefuse::detect_format(o.estimate);
+  const bool any_kitti =
+      o.ref_format == posefuse::Format::kKitti || o.est_format == posefuse::Format::kKitti;
+  if (o.times && !any_kitti) throw apps::usage_error("--times only applies to KITTI files");
+  if (any_kitti && o.ref_format != o.est_format && !o.times)
+    throw apps::usage_error("comparing a KITTI file with a " +
+                            std::string(posefuse::to_string(o.ref_format == posefuse::Format::kKitti
+                                                                ? o.est_format
+                                                                : o.ref_format)) +
+                            " file needs --times for the KITTI one");
+  const bool frame_by_frame = o.ref_format == posefuse::Format::kKitti &&
+                              o.est_format == posefuse::Format::kKitti && !o.times;
+  if (frame_by_frame && (o.motion_filter || o.t_start || o.t_end || o.t_offset != 0.0))
+    throw apps::usage_error(
+        "--motion-filter, --t-start, --t-end and --t-offset need timestamps: give --times "
+        "(KITTI files without it are compared frame by frame)");
+  return o;
+}
+
+int run(const Options& given) {
+  const Options o = resolve_formats(given);
   std::vector<std::string> warnings;
   const posefuse::Trajectory ref_file =
       load(o.groundtruth, o.ref_format, o.times, o.duplicates, false, warnings).trajectory;

@@ -97,7 +97,11 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
             o.estimates);
   cli.custom({.name = "--format", .value = "kitti|tum", .help = "format of all files",
               .default_text = "kitti"},
-             [&](std::string_view v) { o.format = parse_format(v); });
+             [&](std::string_view v) {
+               o.format = parse_format(v);
+               if (o.format == Format::kEuroc)
+                 throw apps::usage_error("expected kitti or tum (EuRoC files: evaluate_trajectory)");
+             });
   cli.path({.name = "--times", .value = "FILE",
             .help = "KITTI times.txt for the ground truth and KITTI estimates"},
            o.times);

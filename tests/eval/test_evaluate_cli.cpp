@@ -398,3 +398,45 @@ TEST_CASE("compare_results: tabulates saved results and ranks comparable ones", 
   CHECK(broken.status == 1);
   CHECK(broken.err.find("x.json: not a saved result") != std::string::npos);
 }
+
+TEST_CASE("Evaluate CLI: formats are detected (EuRoC included) and printed", "[eval][cli][detect]") {
+  POSEFUSE_REQUIRE_EXAMPLE(exe, "evaluate_trajectory");
+  posefuse::test::TempDir dir("cli-detect");
+  const posefuse::Trajectory ref = posefuse::test::make_vehicle_trajectory(120, 91, 1403715273.0);
+  posefuse::write_tum(dir.path() / "est.tum", posefuse::test::perturb(ref, 0.1, 0.01, 92));
+  // The reference as a EuRoC ground truth (ns stamps, q w x y z), with four
+  // repeated stamps as in evo's V102 test file.
+  std::ofstream csv(dir.path() / "gt.csv");
+  csv << "#timestamp,p_RS_R_x [m],p_RS_R_y [m],p_RS_R_z [m],q_RS_w [],q_RS_x [],q_RS_y [],q_RS_z []\n";
+  csv.precision(17);
+  for (std::size_t k = 0; k < ref.size(); ++k) {
+    const Eigen::Vector3d p = ref.poses[k].translation();
+    const Eigen::Quaterniond q(ref.poses[k].linear());
+    const long long t_ns = std::llround(ref.t_s[k] * 1e9);
+    for (int copy = 0; copy < (k % 30 == 5 ? 2 : 1); ++copy)
+      csv << t_ns << ',' << p.x() << ',' << p.y() << ',' << p.z() << ',' << q.w() << ',' << q.x()
+          << ',' << q.y() << ',' << q.z() << '\n';
+  }
+  csv.close();
+  const std::string files = "--groundtruth '" + (dir.path() / "gt.csv").string() + "' --estimate '" +
+                            (dir.path() / "est.tum").string() + "'";
+  const Run r = run(exe, files + " --align se3 --json", dir);
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  const Json j = Json::parse(r.out);
+  CHECK(j["groundtruth_format"].string() == "euroc");
+  CHECK(j["estimate_format"].string() == "tum");
+  CHECK(j["formats_detected"].boolean());
+  CHECK(j["count"].number() == 120.0);
+  CHECK(r.err.find("4 pose(s) with a repeated timestamp dropped") != std::string::npos);
+  const Run table = run(exe, files, dir);
+  CHECK(table.out.find("files  groundtruth euroc (detected), estimate tum (detected)") != std::string::npos);
+  const Run given = run(exe, files + " --groundtruth-format euroc --estimate-format tum", dir);
+  CHECK(given.out.find("files  groundtruth euroc (given), estimate tum (given)") != std::string::npos);
+  // Content that fits no format, or two, is an error, not a guess.
+  std::ofstream(dir.path() / "odd.txt") << "1 2 3 4 5 6 7\n";
+  const Run odd = run(exe, "--groundtruth '" + (dir.path() / "odd.txt").string() + "' --estimate '" +
+                               (dir.path() / "est.tum").string() + "'", dir);
+  CHECK(odd.status == 1);
+  CHECK(odd.err.find("odd.txt:1: cannot tell the format: 7 whitespace-separated fields") != std::string::npos);
+}

@@ -374,7 +374,7 @@ TEST_CASE("Formats: parse_format and read_trajectory dispatch", "[io]") {
   CHECK(posefuse::parse_format("kitti") == posefuse::Format::kKitti);
   CHECK(posefuse::parse_format("tum") == posefuse::Format::kTum);
   CHECK(posefuse::to_string(posefuse::Format::kTum) == "tum");
-  CHECK_THROWS_AS(posefuse::parse_format("euroc"), posefuse::invalid_argument);
+  CHECK_THROWS_AS(posefuse::parse_format("csv"), posefuse::invalid_argument);
   TempDir dir("dispatch");
   const posefuse::Trajectory traj = random_trajectory(5, 3);
   posefuse::write_trajectory(dir.path() / "a.tum", traj, posefuse::Format::kTum);
@@ -553,4 +553,72 @@ TEST_CASE("Formats: the polar re-orthonormalisation equals the SVD's nearest rot
     CHECK((polar.transpose() * polar - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-15);
     CHECK(polar.determinant() > 0.0);
   }
+}
+
+TEST_CASE("Formats: detect_format tells KITTI, TUM and EuRoC apart and refuses to guess",
+          "[io][detect]") {
+  TempDir dir("detect");
+  using posefuse::Format;
+  const std::string euroc8 = "1403715273262142976,0.87,2.18,0.94,0.07,-0.82,-0.11,-0.55\n";
+  const std::string euroc17 =
+      "1403715273262142976, 0.87, 2.18, 0.94, 0.07, -0.82, -0.11, -0.55, 0, 0, 0, 0, 0, 0, 0, 0, 0\n";
+  CHECK(posefuse::detect_format(dir.write("k.txt", kIdentityRow + kIdentityRow)) == Format::kKitti);
+  CHECK(posefuse::detect_format(dir.write("t.tum", "# t x y z qx qy qz qw\n0 0 0 0 0 0 0 1\n")) == Format::kTum);
+  CHECK(posefuse::detect_format(dir.write("c.tum", "0 0 0 0 0 0 0 1 1 0 0 1 0 1\n")) == Format::kTum);
+  CHECK(posefuse::detect_format(dir.write("e.csv", "#timestamp,p_RS_R_x [m],...\n" + euroc8 + euroc8)) == Format::kEuroc);
+  CHECK(posefuse::detect_format(dir.write("f.csv", euroc17)) == Format::kEuroc);
+  CHECK(posefuse::detect_format(dir.write("bom.txt", "\xEF\xBB\xBF" + kIdentityRow)) == Format::kKitti);
+  const struct {
+    const char* name;
+    std::string text;
+    std::size_t line;
+    const char* reason;
+  } refused[] = {
+      {"csv with a non-integer stamp", "1.5,0,0,0,1,0,0,0\n", 1, "starting with '1.5'"},
+      {"csv of another width", "1,2,3\n", 1, "3 comma-separated fields"},
+      {"7 numbers", "# x\n0 0 0 0 0 0 1\n", 2, "7 whitespace-separated fields"},
+      {"a TUM line, then a KITTI line", "0 0 0 0 0 0 0 1\n" + kIdentityRow, 2,
+       "looks like kitti (12 fields) but line 1 like tum (8 fields)"},
+      {"a TUM line, then a covariance line", "0 0 0 0 0 0 0 1\n0 0 0 0 0 0 0 1 1 0 0 1 0 1\n", 2,
+       "(14 fields) but line 1 like tum (8 fields)"},
+  };
+  for (const auto& c : refused) {
+    SECTION(c.name) {
+      const auto file = dir.write("r.txt", c.text);
+      check_error(expect_io_error([&] { (void)posefuse::detect_format(file); }), file, c.line, c.reason);
+      check_error(expect_io_error([&] { (void)posefuse::detect_format(file); }), file, c.line,
+                  "give the format explicitly");
+    }
+  }
+  const auto empty = dir.write("empty.txt", "# nothing\n\n");
+  check_error(expect_io_error([&] { (void)posefuse::detect_format(empty); }), empty, 0, "no poses");
+  CHECK(posefuse::parse_format("euroc") == Format::kEuroc);
+  CHECK(posefuse::to_string(Format::kEuroc) == "euroc");
+}
+
+TEST_CASE("Formats: EuRoC ground truth through read_trajectory, with the duplicate policy",
+          "[io][euroc][duplicates]") {
+  TempDir dir("euroc-dup");
+  const auto file = dir.write("gt.csv",
+                              "#timestamp,px,py,pz,qw,qx,qy,qz\n"
+                              "1000000000,1,0,0,1,0,0,0\n"
+                              "1000000000,2,0,0,1,0,0,0\n"
+                              "1500000000,3,0,0,1,0,0,0\n");
+  check_error(expect_io_error([&] { (void)posefuse::read_trajectory(file, posefuse::Format::kEuroc); }),
+              file, 3, "repeats the previous one");
+  posefuse::ReadOptions options;
+  options.duplicates = posefuse::DuplicateStamps::kLast;
+  posefuse::ReadReport report;
+  const posefuse::Trajectory t =
+      posefuse::read_trajectory(file, posefuse::Format::kEuroc, std::nullopt, options, &report);
+  REQUIRE(t.size() == 2);
+  CHECK(t.t_s == std::vector<double>{1.0, 1.5});
+  CHECK(t.poses[0].translation().x() == 2.0);
+  CHECK(report.duplicates_dropped == 1);
+  CHECK(report.first_duplicate_line == 3);
+  options.duplicates = posefuse::DuplicateStamps::kFirst;
+  CHECK(posefuse::read_trajectory(file, posefuse::Format::kEuroc, std::nullopt, options).poses[0].translation().x() == 1.0);
+  CHECK_THROWS_AS(posefuse::read_trajectory(file, posefuse::Format::kEuroc, file), posefuse::invalid_argument);
+  CHECK_THROWS_AS(posefuse::write_trajectory(dir.path() / "o.csv", t, posefuse::Format::kEuroc),
+                  posefuse::invalid_argument);
 }

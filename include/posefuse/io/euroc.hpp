@@ -22,7 +22,9 @@
 /// (posefuse::io_error, `file:line: reason`). Fields are separated by commas
 /// (spaces around them are allowed). A stamp must be a decimal integer that
 /// fits int64; every other field a finite number. Stamps must increase
-/// strictly: a repeated or earlier stamp is an error naming both lines. A
+/// strictly: a repeated or earlier stamp is an error naming both lines
+/// (the ground-truth reader can keep the first or last of repeated stamps
+/// instead, see ReadOptions::duplicates). A
 /// quaternion must be within `quaternion_norm_tolerance` of unit norm (it is
 /// then normalised). A file without data lines is an error.
 
@@ -168,7 +170,9 @@ template <class Lazy = void>
 /// Reads a EuRoC state ground truth csv with 8 columns (pose) or 17 (pose,
 /// velocity, gyroscope bias, accelerometer bias); see the file comment.
 /// @param[in] file path of `state_groundtruth_estimate0/data.csv` (or any file of that layout)
-/// @param[in] options quaternion norm tolerance
+/// @param[in] options quaternion norm tolerance; repeated stamps follow
+///            `options.duplicates` (the default refuses them)
+/// @param[out] report optional: states dropped for a repeated stamp
 /// @return stamps, poses and, for 17 columns, velocity and biases
 /// @throws posefuse::io_error (file:line) when the file cannot be opened or
 ///         read, the first data line has neither 8 nor 17 fields or a later
@@ -178,7 +182,8 @@ template <class Lazy = void>
 ///         (file only) when it has no data line
 template <class Lazy = void>
 [[nodiscard]] EurocGroundTruth read_euroc_groundtruth(const std::filesystem::path& file,
-                                                      const ReadOptions& options = {}) {
+                                                      const ReadOptions& options = {},
+                                                      ReadReport* report = nullptr) {
   detail::LineReader reader(file);
   EurocGroundTruth gt;
   std::vector<double> v;
@@ -206,12 +211,33 @@ template <class Lazy = void>
                                               : "t[ns], p xyz, q wxyz, v xyz, b_gyro xyz, "
                                                 "b_accel xyz (as the first data line)",
                                  file, n, t_ns, v);
-    if (!gt.t_ns.empty()) detail::euroc_io::check_order(t_ns, gt.t_ns.back(), previous_line, file, n);
     const Eigen::Quaterniond q = detail::traj_io::checked_quaternion(
         Eigen::Quaterniond(v[3], v[4], v[5], v[6]), options.quaternion_norm_tolerance, file, n);
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
     T.linear() = q.toRotationMatrix();
     T.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
+    bool replace = false;
+    if (!gt.t_ns.empty() && t_ns == gt.t_ns.back() && options.duplicates != DuplicateStamps::kError) {
+      // A repeated stamp under the kFirst / kLast policy (see ReadOptions).
+      if (report != nullptr) {
+        if (report->duplicates_dropped == 0) report->first_duplicate_line = n;
+        ++report->duplicates_dropped;
+      }
+      previous_line = n;
+      if (options.duplicates == DuplicateStamps::kFirst) continue;
+      replace = true;
+    } else if (!gt.t_ns.empty()) {
+      detail::euroc_io::check_order(t_ns, gt.t_ns.back(), previous_line, file, n);
+    }
+    if (replace) {
+      gt.trajectory.poses.back() = T;
+      if (columns == 17) {
+        gt.velocity->back() = Eigen::Vector3d(v[7], v[8], v[9]);
+        gt.gyro_bias->back() = Eigen::Vector3d(v[10], v[11], v[12]);
+        gt.accel_bias->back() = Eigen::Vector3d(v[13], v[14], v[15]);
+      }
+      continue;
+    }
     gt.t_ns.push_back(t_ns);
     gt.trajectory.push_back(seconds_from_ns(t_ns), T);
     if (columns == 17) {
