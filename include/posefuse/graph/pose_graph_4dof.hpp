@@ -28,8 +28,6 @@
 /// without a robust loss. Ceres reports \f$ F/2 \f$.
 
 #include <Eigen/Core>
-#include <Eigen/SparseCholesky>
-#include <Eigen/SparseCore>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -409,7 +407,8 @@ class PoseGraph4Dof {
   /// edge_error_4dof), weights it by \f$ \rho'(s) \f$ (IRLS), assembles
   /// \f$ H = \sum J^\top \rho' \Omega J \f$ and \f$ b = \sum J^\top \rho' \Omega e \f$
   /// in 4x4 blocks, and solves \f$ (H + \lambda\,\mathrm{diag}(H)) \Delta = -b \f$
-  /// with a sparse LDLᵀ (block AMD ordering computed once). LM adapts
+  /// with a block sparse Cholesky (detail/block_system.hpp: 4x4 blocks,
+  /// block AMD ordering and symbolic analysis computed once per call). LM adapts
   /// \f$ \lambda \f$ by the gain ratio (Nielsen's rule); a step is taken only
   /// when it lowers the cost. When no node is fixed, the first is held fixed.
   /// @throws posefuse::invalid_argument as validate()
@@ -426,8 +425,8 @@ class PoseGraph4Dof {
     }
     detail::BlockSystem<4> sys;
     sys.build(L.n, L.pairs);
-    detail::BlockCholesky chol;
-    chol.analyzePattern(sys.H);
+    detail::BlockCholesky<4> chol;
+    chol.analyze(sys);
     double cost_now = s.initial_cost;
     double lambda = options.levenberg_marquardt ? options.initial_lambda : 0.0;
     double nu = 2.0;
@@ -452,8 +451,7 @@ class PoseGraph4Dof {
           delta(c) = lambda * std::clamp(diag(c), 1e-6, 1e32);
         sys.add_to_diagonal(delta);
       }
-      chol.factorize(sys.H);
-      const bool factored = chol.info() == Eigen::Success;
+      const bool factored = chol.factorize(sys);
       Eigen::VectorXd dx;
       if (factored) dx = chol.solve(-sys.b);
       if (lambda > 0) sys.add_to_diagonal(-delta);
@@ -581,11 +579,12 @@ class PoseGraph4Dof {
 
   template <int B>
   [[nodiscard]] static Eigen::VectorXd solve(detail::BlockSystem<B>& sys, const char* what) {
-    detail::BlockCholesky chol;
-    chol.compute(sys.H);
+    detail::BlockCholesky<B> chol;
+    chol.analyze(sys);
+    const bool factored = chol.factorize(sys);
     Eigen::VectorXd dx;
-    if (chol.info() == Eigen::Success) dx = chol.solve(-sys.b);
-    if (chol.info() != Eigen::Success || !dx.allFinite())
+    if (factored) dx = chol.solve(-sys.b);
+    if (!factored || !dx.allFinite())
       throw invalid_argument(std::string("pose graph: ") + what +
                              ": the linear system is singular (information too weak to fix every node)");
     return dx;
