@@ -23,6 +23,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <map>
+#include <random>
 #include <numbers>
 
 #include <apps/sim/pose_graph_4dof.hpp>
@@ -144,5 +145,34 @@ BENCHMARK(BM_PoseGraph4Dof_ceres)
     ->Unit(benchmark::kMillisecond);
 
 #endif
+
+}  // namespace
+
+#include <posefuse/graph/marginalization.hpp>
+
+namespace {
+
+/// One marginalisation of a VINS-Mono-sized window: 10 keyframes of 15
+/// states and 100 landmarks (250 variables, dense); the oldest keyframe and
+/// the 30 landmarks it anchors are removed (45 of 250).
+void BM_Marginalization_Window10(benchmark::State& state) {
+  std::mt19937 rng(3);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  const int n = 10 * 15 + 100;
+  Eigen::MatrixXd A(400, n);
+  for (int c = 0; c < n; ++c)
+    for (int r = 0; r < 400; ++r) A(r, c) = n01(rng);
+  const Eigen::MatrixXd H = A.transpose() * A;
+  Eigen::VectorXd b(n);
+  for (int r = 0; r < n; ++r) b(r) = n01(rng);
+  std::vector<int> remove;
+  for (int k = 0; k < 15; ++k) remove.push_back(k);
+  for (int k = 0; k < 30; ++k) remove.push_back(150 + k);
+  for (auto _ : state) {
+    const MarginalizationPrior p = marginalize(H, b, remove);
+    benchmark::DoNotOptimize(p.J.data());
+  }
+}
+BENCHMARK(BM_Marginalization_Window10)->Unit(benchmark::kMillisecond);
 
 }  // namespace
