@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include <posefuse/eval/alignment.hpp>
 #include <posefuse/graph/pose_graph_4dof.hpp>
 #include <posefuse/testing/conformance.hpp>
 
@@ -291,4 +292,39 @@ TEST_CASE("PoseGraph4Dof: bad graphs are refused with a clear message", "[graph]
   graph.set_fixed(3);  // a separately anchored part is well posed
   CHECK_NOTHROW(graph.optimize());
   CHECK_THROWS_WITH(graph.set_fixed(42), Catch::Contains("node 42 does not exist"));
+}
+
+TEST_CASE("align_posyaw: recovers a known 4-DoF (position + yaw) transform exactly", "[graph][eval][alignment]") {
+  std::mt19937 rng(17);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  Trajectory ref;
+  for (int k = 0; k < 50; ++k) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    const double x = 10.0 * n01(rng);
+    const double y = 10.0 * n01(rng);
+    const double z = n01(rng);
+    T.translation() = Eigen::Vector3d(x, y, z);
+    T.linear() = rotation_from_euler_zyx(EulerZYX<double>{0.1 * n01(rng), 0.0, 0.0});
+    ref.push_back(double(k), T);
+  }
+  for (const double psi : {0.7, -3.1, 3.14159}) {
+    Eigen::Isometry3d G = Eigen::Isometry3d::Identity();
+    G.linear() = Eigen::AngleAxisd(psi, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    G.translation() = Eigen::Vector3d(5.0, -2.0, 0.5);
+    Trajectory est = ref;
+    for (Eigen::Isometry3d& T : est.poses) T = G.inverse() * T;
+    const AlignedTrajectory a = align_posyaw(est, ref);
+    CHECK((a.transform.rotation - G.linear()).cwiseAbs().maxCoeff() < 1e-12);
+    CHECK((a.transform.translation - G.translation()).cwiseAbs().maxCoeff() < 1e-12);
+    for (std::size_t k = 0; k < ref.size(); ++k)
+      CHECK((a.trajectory.poses[k].matrix() - ref.poses[k].matrix()).cwiseAbs().maxCoeff() < 1e-11);
+  }
+  // Only yaw: a roll between the sets is not absorbed (SE(3) alignment would).
+  Trajectory rolled = ref;
+  for (Eigen::Isometry3d& T : rolled.poses) T = Eigen::Isometry3d(Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitX())) * T;
+  CHECK(align_posyaw(rolled, ref).transform.rotation.isApprox(Eigen::Matrix3d::Identity(), 1e-2));
+  Trajectory still;
+  still.push_back(0.0, Eigen::Isometry3d::Identity());
+  still.push_back(1.0, Eigen::Isometry3d::Identity());
+  CHECK_THROWS_WITH(align_posyaw(still, still), Catch::Contains("no horizontal spread"));
 }
