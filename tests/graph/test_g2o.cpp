@@ -3,6 +3,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -179,4 +180,47 @@ TEST_CASE("optimize_pose_graph: built-in graph, JSON, --out and errors", "[graph
   CHECK(disconnected.status == 1);
   CHECK_THAT(disconnected.err, Catch::Contains("disconnected") && Catch::Contains("ids 1"));
   CHECK(posefuse::test::run(exe, "--init nope", dir).status == 2);
+}
+
+TEST_CASE("pose_graph_correction: built-in drive, robust loss, loop file and errors", "[graph][examples]") {
+  POSEFUSE_REQUIRE_EXAMPLE(exe, "pose_graph_correction");
+  TempDir dir("correction");
+  const auto r = posefuse::test::run(exe, "--json --svg '" + (dir.path() / "g.svg").string() + "'", dir);
+  REQUIRE(r.status == 0);
+  const posefuse::test::Json j = posefuse::test::Json::parse(r.out);
+  CHECK(j["outliers"].number() == 5);
+  const double before = j["ape_before"]["se3"].number();
+  const double after = j["ape_after"]["se3"].number();
+  INFO("APE before " << before << " m, after " << after << " m");
+  CHECK(after < 0.2 * before);  // built-in drive: 1.79 m -> 0.12 m
+  CHECK(j["ape_after"]["posyaw"].number() < 0.2 * j["ape_before"]["posyaw"].number());
+  CHECK(std::filesystem::file_size(dir.path() / "g.svg") > 1000);
+  // Without a robust loss the 5 false loops ruin the result.
+  const auto plain = posefuse::test::run(exe, "--json --robust none", dir);
+  REQUIRE(plain.status == 0);
+  CHECK(posefuse::test::Json::parse(plain.out)["ape_after"]["se3"].number() > before);
+
+  // A loop file on a small KITTI-format odometry, and one naming a missing pose.
+  std::string odo, gt;
+  for (int k = 0; k < 30; ++k) {
+    const double a = 0.2 * k;
+    const std::string row = "1 0 0 " + std::to_string(10 * std::sin(a)) + " 0 1 0 0 0 0 1 " +
+                            std::to_string(10 * std::cos(a)) + "\n";
+    gt += row;
+    odo += row;
+  }
+  const auto odo_file = write_text(dir, "odo.txt", odo);
+  const auto gt_file = write_text(dir, "gt.txt", gt);
+  const auto loops = write_text(dir, "loops.txt", "0 29 0 0 0 0 1 0 0 0 1 0 0 1 0 1\n");
+  const auto ok = posefuse::test::run(exe, "--odometry '" + odo_file.string() + "' --groundtruth '" + gt_file.string() +
+                                               "' --loops '" + loops.string() + "'",
+                                      dir);
+  CHECK(ok.status == 0);
+  const auto bad_loops = write_text(dir, "bad.txt", "0 99 0 0 0 0 1 0 0 0 1 0 0 1 0 1\n");
+  const auto bad = posefuse::test::run(exe, "--odometry '" + odo_file.string() + "' --groundtruth '" +
+                                                gt_file.string() + "' --loops '" + bad_loops.string() + "'",
+                                       dir);
+  CHECK(bad.status == 1);
+  CHECK_THAT(bad.err, Catch::Contains("node 99 does not exist"));
+  CHECK(posefuse::test::run(exe, "--oracle-loops", dir).status == 2);
 }
