@@ -203,4 +203,64 @@ template <class Lazy = void>
   return {apply_alignment(est, a), a};
 }
 
+/// Least-squares 4-DoF alignment: position and yaw only (rotation about the
+/// world z axis), for visual-inertial estimates whose roll and pitch are
+/// observable from gravity (VINS-Mono, Qin et al. 2018; evo has no such mode).
+/// Minimises \f$ \sum \lVert y_i - (R_z(\psi) x_i + t) \rVert^2 \f$: with the
+/// centred points \f$ a_i = x_i - \mu_x \f$, \f$ b_i = y_i - \mu_y \f$,
+/// \f$ \psi = \mathrm{atan2}\big(\sum (a_{i,x} b_{i,y} - a_{i,y} b_{i,x}),
+/// \sum (a_{i,x} b_{i,x} + a_{i,y} b_{i,y})\big) \f$ and \f$ t = \mu_y - R_z(\psi)\mu_x \f$
+/// (the planar case of Umeyama 1991 / Horn 1987).
+/// @param[in] x source points (estimate), at least 2
+/// @param[in] y target points (reference), same count, `y[i]` registered to `x[i]`
+/// @return \f$ (R_z(\psi), t, 1) \f$
+/// @throws posefuse::invalid_argument for different counts, fewer than 2
+///         points, non-finite points, or no horizontal spread (the yaw is undefined)
+template <class Lazy = void>
+[[nodiscard]] AlignmentResult posyaw_alignment(std::span<const Eigen::Vector3d> x,
+                                               std::span<const Eigen::Vector3d> y) {
+  if (x.size() != y.size())
+    throw invalid_argument("posyaw_alignment: " + std::to_string(x.size()) + " source but " +
+                           std::to_string(y.size()) + " target points");
+  if (x.size() < 2) throw invalid_argument("posyaw_alignment: needs at least 2 points");
+  Eigen::Vector3d mx = Eigen::Vector3d::Zero(), my = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    if (!x[i].allFinite() || !y[i].allFinite())
+      throw invalid_argument("posyaw_alignment: point " + std::to_string(i) + " is not finite");
+    mx += x[i];
+    my += y[i];
+  }
+  mx /= double(x.size());
+  my /= double(y.size());
+  double C = 0.0, S = 0.0, norms = 0.0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const Eigen::Vector2d a = (x[i] - mx).head<2>(), b = (y[i] - my).head<2>();
+    C += a.dot(b);
+    S += a.x() * b.y() - a.y() * b.x();
+    norms += a.norm() * b.norm();
+  }
+  if (!(std::hypot(C, S) > 1e-12 * norms) || norms == 0.0)
+    throw invalid_argument("posyaw_alignment: the points have no horizontal spread; the yaw is undefined");
+  const double psi = std::atan2(S, C);
+  AlignmentResult r;
+  r.rotation = Eigen::AngleAxisd(psi, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  r.translation = my - r.rotation * mx;
+  return r;
+}
+
+/// Aligns `est` to `ref` by position and yaw (posyaw_alignment on all their
+/// already associated positions), then moves every pose by it.
+/// @throws posefuse::invalid_argument for different sizes or the cases of posyaw_alignment
+template <class Lazy = void>
+[[nodiscard]] AlignedTrajectory align_posyaw(const Trajectory& est, const Trajectory& ref) {
+  if (est.size() != ref.size())
+    throw invalid_argument("align_posyaw: estimate has " + std::to_string(est.size()) +
+                           " poses but reference has " + std::to_string(ref.size()) +
+                           " (associate them first)");
+  const std::vector<Eigen::Vector3d> x = est.positions();
+  const std::vector<Eigen::Vector3d> y = ref.positions();
+  const AlignmentResult a = posyaw_alignment(x, y);
+  return {apply_alignment(est, a), a};
+}
+
 }  // namespace posefuse

@@ -1,0 +1,178 @@
+// bench_graph: 4-DoF pose-graph optimisation, posefuse against Ceres 2.1 on
+// the same seeded problems (examples/apps/sim/pose_graph_4dof.hpp: laps of a
+// hilly track, odometry + a loop edge on every 4th pose, start = chained
+// odometry).
+//
+//   BM_PoseGraph4Dof/posefuse/N  build the graph + PoseGraph4Dof::optimize()
+//                                (LM from the odometry start, function
+//                                tolerance 1e-10)
+//   BM_PoseGraph4Dof/ceres/N     build a ceres::Problem + Solve (only when
+//                                Ceres is found): the same residual with
+//                                automatic differentiation, one [x y z yaw]
+//                                block per pose, LM, SPARSE_NORMAL_CHOLESKY,
+//                                function tolerance 1e-10, one thread
+//
+// Counters: chi2 (g2o convention, = 2x Ceres's cost), iterations. Run Ceres
+// with OMP_THREAD_LIMIT=1 (Debian's CHOLMOD otherwise starts OpenMP threads):
+//
+//   OMP_THREAD_LIMIT=1 ./build-release/benchmarks/bench_graph --benchmark_repetitions=5
+//       --benchmark_report_aggregates_only=true
+
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <map>
+#include <random>
+#include <numbers>
+
+#include <apps/sim/pose_graph_4dof.hpp>
+#include <posefuse/graph/pose_graph_4dof.hpp>
+
+#ifdef POSEFUSE_HAVE_CERES
+#include <ceres/ceres.h>
+#endif
+
+namespace {
+
+using namespace posefuse;
+
+const sim::PoseGraphProblem& problem(int n) {
+  static std::map<int, sim::PoseGraphProblem> cache;
+  auto it = cache.find(n);
+  if (it == cache.end()) {
+    sim::PoseGraphProblemConfig c;
+    c.nodes = n;
+    c.seed = 42;
+    it = cache.emplace(n, sim::make_pose_graph_problem(c)).first;
+  }
+  return it->second;
+}
+
+void BM_PoseGraph4Dof_posefuse(benchmark::State& state) {
+  const sim::PoseGraphProblem& pr = problem(static_cast<int>(state.range(0)));
+  PoseGraphSummary s;
+  for (auto _ : state) {
+    PoseGraph4Dof g = sim::to_pose_graph(pr);
+    s = g.optimize();
+    benchmark::DoNotOptimize(s);
+  }
+  state.counters["chi2"] = s.final_cost;
+  state.counters["iterations"] = s.iterations;
+}
+BENCHMARK(BM_PoseGraph4Dof_posefuse)
+    ->Name("BM_PoseGraph4Dof/posefuse")
+    ->Arg(1000)->Arg(10000)->Arg(100000)
+    ->Unit(benchmark::kMillisecond);
+
+#ifdef POSEFUSE_HAVE_CERES
+
+/// Angle wrapped to [-π, π) for Ceres's Jets (Ceres's pose_graph_2d
+/// normalize_angle idea, written here).
+template <class T>
+T wrap(const T& a) {
+  const T two_pi(2.0 * std::numbers::pi);
+  return a - two_pi * ceres::floor((a + T(std::numbers::pi)) / two_pi);
+}
+
+/// The standard 4-DoF residual (VINS-Mono's four-DoF error with g2o's
+/// measurement-frame translation error), whitened by the information's
+/// upper Cholesky factor.
+struct FourDofError {
+  Eigen::Matrix3d Qi_t;
+  Eigen::Vector3d dp;
+  double dyaw;
+  Eigen::Matrix4d sqrt_info;
+
+  template <class T>
+  bool operator()(const T* xi, const T* xj, T* residual) const {
+    const T d0 = xj[0] - xi[0], d1 = xj[1] - xi[1], d2 = xj[2] - xi[2];
+    const T ci = ceres::cos(xi[3]), si = ceres::sin(xi[3]);
+    // w = Rz(yaw_i)^T d
+    const T w0 = ci * d0 + si * d1, w1 = -si * d0 + ci * d1, w2 = d2;
+    T u[3];
+    for (int r = 0; r < 3; ++r) u[r] = T(Qi_t(r, 0)) * w0 + T(Qi_t(r, 1)) * w1 + T(Qi_t(r, 2)) * w2 - T(dp(r));
+    const double cm = std::cos(dyaw), sm = std::sin(dyaw);
+    T e[4];
+    e[0] = cm * u[0] + sm * u[1];
+    e[1] = -sm * u[0] + cm * u[1];
+    e[2] = u[2];
+    e[3] = wrap(xj[3] - xi[3] - T(dyaw));
+    for (int r = 0; r < 4; ++r) {
+      residual[r] = T(0);
+      for (int c = r; c < 4; ++c) residual[r] += T(sqrt_info(r, c)) * e[c];
+    }
+    return true;
+  }
+};
+
+void BM_PoseGraph4Dof_ceres(benchmark::State& state) {
+  const sim::PoseGraphProblem& pr = problem(static_cast<int>(state.range(0)));
+  double chi2 = 0;
+  int iterations = 0;
+  for (auto _ : state) {
+    std::vector<std::array<double, 4>> x(pr.initial.size());
+    for (std::size_t k = 0; k < x.size(); ++k)
+      x[k] = {pr.initial[k].p.x(), pr.initial[k].p.y(), pr.initial[k].p.z(), pr.initial[k].yaw};
+    ceres::Problem problem;
+    for (const Edge4Dof& e : pr.edges) {
+      const Pose4Dof& a = pr.initial[std::size_t(e.from)];
+      FourDofError f{rotation_from_euler_zyx(EulerZYX<double>{a.roll, a.pitch, 0.0}).transpose(), e.dp, e.dyaw,
+                     e.information.llt().matrixU()};
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<FourDofError, 4, 4, 4>(new FourDofError(f)),
+                               nullptr, x[std::size_t(e.from)].data(), x[std::size_t(e.to)].data());
+    }
+    problem.SetParameterBlockConstant(x[0].data());
+    ceres::Solver::Options o;
+    o.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+    o.max_num_iterations = 100;
+    o.function_tolerance = 1e-10;
+    o.num_threads = 1;
+    ceres::Solver::Summary summary;
+    ceres::Solve(o, &problem, &summary);
+    chi2 = 2.0 * summary.final_cost;
+    iterations = static_cast<int>(summary.iterations.size()) - 1;
+    benchmark::DoNotOptimize(x.data());
+  }
+  state.counters["chi2"] = chi2;
+  state.counters["iterations"] = iterations;
+  const char* limit = std::getenv("OMP_THREAD_LIMIT");
+  if (limit == nullptr || std::string(limit) != "1") state.SetLabel("OMP_THREAD_LIMIT is not 1");
+}
+BENCHMARK(BM_PoseGraph4Dof_ceres)
+    ->Name("BM_PoseGraph4Dof/ceres")
+    ->Arg(1000)->Arg(10000)->Arg(100000)
+    ->Unit(benchmark::kMillisecond);
+
+#endif
+
+}  // namespace
+
+#include <posefuse/graph/marginalization.hpp>
+
+namespace {
+
+/// One marginalisation of a VINS-Mono-sized window: 10 keyframes of 15
+/// states and 100 landmarks (250 variables, dense); the oldest keyframe and
+/// the 30 landmarks it anchors are removed (45 of 250).
+void BM_Marginalization_Window10(benchmark::State& state) {
+  std::mt19937 rng(3);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  const int n = 10 * 15 + 100;
+  Eigen::MatrixXd A(400, n);
+  for (int c = 0; c < n; ++c)
+    for (int r = 0; r < 400; ++r) A(r, c) = n01(rng);
+  const Eigen::MatrixXd H = A.transpose() * A;
+  Eigen::VectorXd b(n);
+  for (int r = 0; r < n; ++r) b(r) = n01(rng);
+  std::vector<int> remove;
+  for (int k = 0; k < 15; ++k) remove.push_back(k);
+  for (int k = 0; k < 30; ++k) remove.push_back(150 + k);
+  for (auto _ : state) {
+    const MarginalizationPrior p = marginalize(H, b, remove);
+    benchmark::DoNotOptimize(p.J.data());
+  }
+}
+BENCHMARK(BM_Marginalization_Window10)->Unit(benchmark::kMillisecond);
+
+}  // namespace

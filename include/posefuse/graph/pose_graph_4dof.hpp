@@ -1,0 +1,648 @@
+#pragma once
+/// @file
+/// 4-DoF pose-graph optimisation (x, y, z, yaw; roll and pitch held fixed):
+/// VINS-Mono's global pose graph (Qin, Li, Shen, "VINS-Mono: A Robust and
+/// Versatile Monocular Visual-Inertial State Estimator", IEEE T-RO 2018,
+/// Sec. VIII; SPEC.md C) solved without Ceres — Gauss–Newton or
+/// Levenberg–Marquardt with analytic Jacobians, a block-ordered sparse
+/// Cholesky and per-edge robust losses, plus the rotation-first
+/// initialisation of Carlone et al. 2015.
+///
+/// **Poses.** Node i is \f$ (p_i, \psi_i) \f$ with a fixed roll/pitch
+/// rotation \f$ Q_i = R_y(\theta_i) R_x(\phi_i) \f$, so its attitude is
+/// \f$ R_i = R_z(\psi_i)\, Q_i \f$ (ZYX, as lie/rotation.hpp). A planar
+/// graph is the special case \f$ z = 0, Q_i = I \f$.
+///
+/// **Edge error** (g2o's EDGE_SE2 error, Kümmerle et al., "g2o: A General
+/// Framework for Graph Optimization", ICRA 2011, extended to 4-DoF): an edge
+/// i → j measures the position of j in i's frame \f$ \Delta p \f$ and the
+/// relative yaw \f$ \Delta\psi \f$;
+/// \f[ e_t = R_z(\Delta\psi)^\top \big( R_i^\top (p_j - p_i) - \Delta p \big), \qquad
+///     e_\psi = \mathrm{wrap}(\psi_j - \psi_i - \Delta\psi), \f]
+/// i.e. the translation error is expressed in the measurement's frame, as
+/// \f$ t2v(Z^{-1} X_i^{-1} X_j) \f$ in g2o for planar poses. With
+/// \f$ e = [e_t; e_\psi] \f$ and the edge's 4x4 information \f$ \Omega \f$
+/// (order x, y, z, yaw), the edge's squared error is \f$ s = e^\top \Omega e \f$.
+///
+/// **Cost** (g2o's χ²): \f$ F = \sum_k \rho_k(s_k) \f$ with \f$ \rho(s) = s \f$
+/// without a robust loss. Ceres reports \f$ F/2 \f$.
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numbers>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include <posefuse/core/angles.hpp>
+#include <posefuse/core/error.hpp>
+#include <posefuse/core/gaussian.hpp>
+#include <posefuse/graph/detail/block_system.hpp>
+#include <posefuse/lie/rotation.hpp>
+#include <posefuse/lie/so2.hpp>
+
+namespace posefuse {
+
+/// A 4-DoF pose: position (m, world), yaw (rad) and the fixed roll and pitch (rad).
+struct Pose4Dof {
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();  ///< position in the world frame (m)
+  double yaw = 0.0;                             ///< \f$ \psi \f$ about world z (rad)
+  double pitch = 0.0;                           ///< \f$ \theta \f$, held fixed (rad)
+  double roll = 0.0;                            ///< \f$ \phi \f$, held fixed (rad)
+};
+
+/// Robust loss \f$ \rho(s) \f$ of an edge's squared error \f$ s = e^\top\Omega e \f$.
+enum class RobustLoss {
+  kNone,    ///< \f$ \rho(s) = s \f$
+  kHuber,   ///< \f$ \rho(s) = s \f$ for \f$ s \le \delta^2 \f$, else \f$ 2\delta\sqrt{s} - \delta^2 \f$
+  kCauchy,  ///< \f$ \rho(s) = c^2 \log(1 + s/c^2) \f$
+};
+
+/// A robust loss with its scale (\f$ \delta \f$ or \f$ c \f$, in whitened units).
+struct RobustKernel {
+  RobustLoss type = RobustLoss::kNone;  ///< which loss
+  double scale = 1.0;                   ///< \f$ \delta \f$ (Huber) or \f$ c \f$ (Cauchy), > 0
+
+  /// \f$ \rho(s) \f$.
+  [[nodiscard]] double rho(double s) const noexcept {
+    switch (type) {
+      case RobustLoss::kNone: return s;
+      case RobustLoss::kHuber: {
+        const double d2 = scale * scale;
+        return s <= d2 ? s : 2.0 * scale * std::sqrt(s) - d2;
+      }
+      case RobustLoss::kCauchy: {
+        const double c2 = scale * scale;
+        return c2 * std::log1p(s / c2);
+      }
+    }
+    return s;
+  }
+  /// \f$ \rho'(s) \f$, the iteratively-reweighted least-squares weight (in (0, 1]).
+  [[nodiscard]] double weight(double s) const noexcept {
+    switch (type) {
+      case RobustLoss::kNone: return 1.0;
+      case RobustLoss::kHuber: return s <= scale * scale ? 1.0 : scale / std::sqrt(s);
+      case RobustLoss::kCauchy: return 1.0 / (1.0 + s / (scale * scale));
+    }
+    return 1.0;
+  }
+};
+
+/// A relative 4-DoF measurement between two nodes (ids).
+struct Edge4Dof {
+  std::int64_t from = 0;                                     ///< node i (the measurement's frame)
+  std::int64_t to = 0;                                       ///< node j
+  Eigen::Vector3d dp = Eigen::Vector3d::Zero();              ///< \f$ \Delta p \f$: j's position in i's frame (m)
+  double dyaw = 0.0;                                         ///< \f$ \Delta\psi = \psi_j - \psi_i \f$ (rad)
+  Eigen::Matrix4d information = Eigen::Matrix4d::Identity();  ///< \f$ \Omega \f$, order x, y, z, yaw
+  RobustKernel loss;                                         ///< robust loss (none by default)
+};
+
+/// The fixed roll/pitch rotation \f$ Q = R_y(\theta) R_x(\phi) \f$ of a pose.
+template <class Lazy = void>
+[[nodiscard]] Eigen::Matrix3d roll_pitch_rotation(const Pose4Dof& x) {
+  return rotation_from_euler_zyx(EulerZYX<double>{x.roll, x.pitch, 0.0});
+}
+
+/// \f$ R_z(\psi)^\top v \f$ through SO(2) on the horizontal components.
+/// @param[out] J_r_psi if not null, \f$ \partial (R_z(\psi)^\top v) / \partial\psi \f$
+template <class Lazy = void>
+[[nodiscard]] Eigen::Vector3d rotate_z_inverse(double psi, const Eigen::Vector3d& v,
+                                               Eigen::Vector3d* J_r_psi = nullptr) {
+  const SO2<double> Rinv = SO2<double>(psi).inverse();
+  Eigen::Vector2d J_q_g;
+  const Eigen::Vector2d q = Rinv.act(v.head<2>(), &J_q_g);
+  // q = R(-ψ) v: d q / d ψ = -(d q / d(-ψ)) = -J_q_g.
+  if (J_r_psi) *J_r_psi << -J_q_g, 0.0;
+  return Eigen::Vector3d(q.x(), q.y(), v.z());
+}
+
+/// The 4-DoF edge error \f$ e = [e_t; e_\psi] \f$ (see the file comment) and
+/// its Jacobians with respect to \f$ x_i = [p_i; \psi_i] \f$ and \f$ x_j \f$.
+/// @param[in] Qi_t \f$ Q_i^\top \f$, node i's fixed roll/pitch rotation transposed
+/// @param[out] J_e_xi if not null, \f$ \partial e / \partial [p_i; \psi_i] \f$ (4x4)
+/// @param[out] J_e_xj if not null, \f$ \partial e / \partial [p_j; \psi_j] \f$ (4x4)
+/// \f[ \frac{\partial e_t}{\partial p_j} = -\frac{\partial e_t}{\partial p_i} = M R_i^\top, \;
+///     \frac{\partial e_t}{\partial \psi_i} = M Q_i^\top \frac{d R_z(\psi_i)^\top}{d\psi_i}(p_j - p_i), \;
+///     \frac{\partial e_\psi}{\partial \psi_j} = -\frac{\partial e_\psi}{\partial \psi_i} = 1, \f]
+/// with \f$ M = R_z(\Delta\psi)^\top \f$.
+template <class Lazy = void>
+[[nodiscard]] Eigen::Vector4d edge_error_4dof(const Eigen::Vector3d& pi, double yaw_i,
+                                              const Eigen::Matrix3d& Qi_t,
+                                              const Eigen::Vector3d& pj, double yaw_j,
+                                              const Eigen::Vector3d& dp, double dyaw,
+                                              Eigen::Matrix4d* J_e_xi = nullptr,
+                                              Eigen::Matrix4d* J_e_xj = nullptr) {
+  const Eigen::Vector3d d = pj - pi;
+  Eigen::Vector3d J_w_psi;
+  const Eigen::Vector3d w = rotate_z_inverse(yaw_i, d, &J_w_psi);  // R_z(ψ_i)^T d
+  const Eigen::Vector3d u = Qi_t * w;                              // R_i^T d
+  const Eigen::Vector3d et = rotate_z_inverse(dyaw, u - dp);
+  Eigen::Vector4d e;
+  e << et, wrap_angle(yaw_j - yaw_i - dyaw);
+  if (J_e_xi || J_e_xj) {
+    // M R_i^T = M Q_i^T R_z(ψ_i)^T: columns are M Q_i^T R_z(ψ_i)^T applied to unit vectors.
+    const SO2<double> Rz_i(yaw_i);
+    const SO2<double> M(-dyaw);
+    Eigen::Matrix3d Rzi_t = Eigen::Matrix3d::Identity();
+    Rzi_t.topLeftCorner<2, 2>() = Rz_i.matrix().transpose();
+    Eigen::Matrix3d Mm = Eigen::Matrix3d::Identity();
+    Mm.topLeftCorner<2, 2>() = M.matrix();
+    const Eigen::Matrix3d A = Mm * Qi_t * Rzi_t;
+    if (J_e_xi) {
+      J_e_xi->setZero();
+      J_e_xi->topLeftCorner<3, 3>() = -A;
+      J_e_xi->block<3, 1>(0, 3) = Mm * (Qi_t * J_w_psi);
+      (*J_e_xi)(3, 3) = -1.0;
+    }
+    if (J_e_xj) {
+      J_e_xj->setZero();
+      J_e_xj->topLeftCorner<3, 3>() = A;
+      (*J_e_xj)(3, 3) = 1.0;
+    }
+  }
+  return e;
+}
+
+/// Why the optimiser stopped.
+enum class Termination {
+  kFunctionTolerance,   ///< relative cost decrease below the tolerance
+  kGradientTolerance,   ///< largest gradient entry below the tolerance
+  kParameterTolerance,  ///< step below the tolerance relative to the state
+  kMaxIterations,       ///< iteration limit reached
+  kNoProgress,          ///< no step decreased the cost (damping exhausted, or a GN step increased it)
+};
+
+/// Name of a termination reason ("function_tolerance", ...).
+[[nodiscard]] constexpr std::string_view to_string(Termination t) noexcept {
+  switch (t) {
+    case Termination::kFunctionTolerance: return "function_tolerance";
+    case Termination::kGradientTolerance: return "gradient_tolerance";
+    case Termination::kParameterTolerance: return "parameter_tolerance";
+    case Termination::kMaxIterations: return "max_iterations";
+    case Termination::kNoProgress: return "no_progress";
+  }
+  return "?";
+}
+
+/// Optimiser settings.
+struct PoseGraphOptions {
+  bool levenberg_marquardt = true;    ///< false: undamped Gauss–Newton (stops when a step increases the cost)
+  int max_iterations = 100;           ///< linear solves at most
+  double function_tolerance = 1e-10;  ///< stop when \f$ (F_k - F_{k+1}) < \mathrm{tol}\, F_k \f$
+  double gradient_tolerance = 1e-12;  ///< stop when \f$ \|J^\top W \Omega e\|_\infty < \mathrm{tol} \f$
+  double parameter_tolerance = 1e-10;  ///< stop when \f$ \|\Delta\| < \mathrm{tol} (\|x\| + \mathrm{tol}) \f$
+  double initial_lambda = 1e-5;       ///< LM damping \f$ \lambda \f$: \f$ H + \lambda\,\mathrm{diag}(H) \f$
+};
+
+/// What an optimisation did.
+struct PoseGraphSummary {
+  double initial_cost = 0.0;  ///< \f$ F \f$ before (χ² without robust losses)
+  double final_cost = 0.0;    ///< \f$ F \f$ after
+  int iterations = 0;         ///< linear solves (accepted and rejected steps)
+  int accepted = 0;           ///< steps that decreased the cost
+  Termination termination = Termination::kMaxIterations;  ///< why it stopped
+  double solve_time_s = 0.0;  ///< wall time of optimize() (s)
+};
+
+/// A 4-DoF pose graph: nodes with unique ids, relative edges, fixed nodes.
+///
+/// Usage: add_node for every pose, add_edge for every measurement, optionally
+/// initialize_rotation_first(), then optimize(). Nodes keep their insertion
+/// order; ids are any std::int64_t values.
+class PoseGraph4Dof {
+ public:
+  /// Adds a node.
+  /// @param[in] id unique id
+  /// @param[in] pose initial pose (roll and pitch stay fixed)
+  /// @param[in] fixed held constant by the optimiser
+  /// @throws posefuse::invalid_argument for a duplicate id or a non-finite pose
+  void add_node(std::int64_t id, const Pose4Dof& pose, bool fixed = false) {
+    if (!pose.p.allFinite() || !std::isfinite(pose.yaw) || !std::isfinite(pose.pitch) ||
+        !std::isfinite(pose.roll))
+      throw invalid_argument("pose graph: node " + std::to_string(id) + " has a non-finite pose");
+    if (!index_.emplace(id, static_cast<int>(ids_.size())).second)
+      throw invalid_argument("pose graph: duplicate node id " + std::to_string(id));
+    ids_.push_back(id);
+    poses_.push_back(pose);
+    poses_.back().yaw = wrap_angle(pose.yaw);
+    Qt_.push_back(roll_pitch_rotation(pose).transpose());
+    fixed_.push_back(fixed ? 1 : 0);
+  }
+
+  /// Adds an edge and returns its index.
+  /// @throws posefuse::invalid_argument naming the edge when a node is
+  ///         missing, both ends are one node, the measurement is not finite,
+  ///         the information is not finite, not symmetric or not positive
+  ///         semi-definite, or a robust-loss scale is not finite and > 0
+  std::size_t add_edge(const Edge4Dof& e) {
+    const std::string what = "pose graph: edge " + std::to_string(edges_.size()) + " (" +
+                             std::to_string(e.from) + " -> " + std::to_string(e.to) + ")";
+    const auto fi = index_.find(e.from);
+    const auto ti = index_.find(e.to);
+    if (fi == index_.end()) throw invalid_argument(what + ": node " + std::to_string(e.from) + " does not exist");
+    if (ti == index_.end()) throw invalid_argument(what + ": node " + std::to_string(e.to) + " does not exist");
+    if (fi->second == ti->second) throw invalid_argument(what + ": both ends are the same node");
+    if (!e.dp.allFinite() || !std::isfinite(e.dyaw))
+      throw invalid_argument(what + ": the measurement is not finite");
+    if (!e.information.allFinite()) throw invalid_argument(what + ": the information matrix is not finite");
+    if (!is_positive_semidefinite(e.information))
+      throw invalid_argument(what + ": the information matrix is not symmetric positive semi-definite");
+    if (e.loss.type != RobustLoss::kNone && !(std::isfinite(e.loss.scale) && e.loss.scale > 0))
+      throw invalid_argument(what + ": the robust-loss scale must be finite and > 0");
+    edges_.push_back(e);
+    ends_.emplace_back(fi->second, ti->second);
+    return edges_.size() - 1;
+  }
+
+  /// Holds node `id` fixed (or frees it).
+  /// @throws posefuse::invalid_argument when the node does not exist
+  void set_fixed(std::int64_t id, bool fixed = true) { fixed_[std::size_t(node_index(id))] = fixed ? 1 : 0; }
+  /// True when node `id` is held fixed.
+  [[nodiscard]] bool is_fixed(std::int64_t id) const { return fixed_[std::size_t(node_index(id))] != 0; }
+  /// Number of nodes.
+  [[nodiscard]] std::size_t num_nodes() const noexcept { return poses_.size(); }
+  /// Number of edges.
+  [[nodiscard]] std::size_t num_edges() const noexcept { return edges_.size(); }
+  /// Node ids in insertion order.
+  [[nodiscard]] const std::vector<std::int64_t>& ids() const noexcept { return ids_; }
+  /// Poses in insertion order.
+  [[nodiscard]] const std::vector<Pose4Dof>& poses() const noexcept { return poses_; }
+  /// The edges in insertion order.
+  [[nodiscard]] const std::vector<Edge4Dof>& edges() const noexcept { return edges_; }
+  /// The pose of node `id`.
+  /// @throws posefuse::invalid_argument when the node does not exist
+  [[nodiscard]] const Pose4Dof& pose(std::int64_t id) const { return poses_[std::size_t(node_index(id))]; }
+  /// Replaces the pose of node `id` (roll and pitch included).
+  /// @throws posefuse::invalid_argument when the node does not exist or the pose is not finite
+  void set_pose(std::int64_t id, const Pose4Dof& pose) {
+    const int k = node_index(id);
+    if (!pose.p.allFinite() || !std::isfinite(pose.yaw) || !std::isfinite(pose.pitch) ||
+        !std::isfinite(pose.roll))
+      throw invalid_argument("pose graph: node " + std::to_string(id) + " set to a non-finite pose");
+    poses_[std::size_t(k)] = pose;
+    poses_[std::size_t(k)].yaw = wrap_angle(pose.yaw);
+    Qt_[std::size_t(k)] = roll_pitch_rotation(pose).transpose();
+  }
+
+  /// The cost \f$ F = \sum_k \rho_k(e_k^\top \Omega_k e_k) \f$ at the current poses.
+  [[nodiscard]] double cost() const { return cost_at(poses_); }
+
+  /// Checks that every node is linked through edges to a fixed node (when
+  /// no node is fixed, the first one is taken as fixed, as optimize() does).
+  /// @throws posefuse::invalid_argument when the graph is empty, or is
+  ///         disconnected: the message names the nodes (up to 10 ids) that
+  ///         no edge path links to a fixed node, and how many there are
+  void validate() const {
+    if (poses_.empty()) throw invalid_argument("pose graph: no nodes");
+    const std::vector<char> fixed = effective_fixed();
+    std::vector<int> parent(poses_.size());
+    for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int>(i);
+    const auto find = [&parent](int x) {
+      while (parent[std::size_t(x)] != x) {
+        parent[std::size_t(x)] = parent[std::size_t(parent[std::size_t(x)])];
+        x = parent[std::size_t(x)];
+      }
+      return x;
+    };
+    for (const auto& e : ends_) {
+      const int a = find(e.first), b = find(e.second);
+      if (a != b) parent[std::size_t(a)] = b;
+    }
+    std::vector<char> anchored(poses_.size(), 0);
+    for (std::size_t i = 0; i < poses_.size(); ++i)
+      if (fixed[i]) anchored[std::size_t(find(static_cast<int>(i)))] = 1;
+    std::vector<std::int64_t> loose;
+    for (std::size_t i = 0; i < poses_.size(); ++i)
+      if (!anchored[std::size_t(find(static_cast<int>(i)))]) loose.push_back(ids_[i]);
+    if (loose.empty()) return;
+    std::string list;
+    for (std::size_t k = 0; k < loose.size() && k < 10; ++k) {
+      if (k > 0) list += ", ";
+      list += std::to_string(loose[k]);
+    }
+    if (loose.size() > 10) list += ", ...";
+    throw invalid_argument("pose graph is disconnected: " + std::to_string(loose.size()) +
+                           " node(s) are not linked by any edge path to a fixed node (ids " + list +
+                           "); add edges or fix a node in each part");
+  }
+
+  /// Rotation-first initialisation (Carlone, Tron, Daniilidis, Dellaert,
+  /// "Initialization techniques for 3D SLAM: a survey on rotation estimation
+  /// and its use in pose graph optimization", ICRA 2015, chordal relaxation):
+  /// 1. yaw: minimise \f$ \sum_k \Omega_{k,\psi\psi} \| v_j - R(\Delta\psi_k) v_i \|^2 \f$
+  ///    over unconstrained 2-vectors \f$ v_i \f$ (the first column of
+  ///    \f$ R_z(\psi_i) \f$; fixed nodes keep theirs), a sparse linear least
+  ///    squares, then \f$ \psi_i = \mathrm{atan2}(v_{i,y}, v_{i,x}) \f$;
+  /// 2. translation: with the yaws fixed the cost is quadratic in the
+  ///    positions; one exact Newton step minimises it.
+  /// Robust losses are ignored here (weights 1).
+  /// @throws posefuse::invalid_argument as validate(), or when a linear system is singular
+  void initialize_rotation_first() {
+    validate();
+    const Layout L = layout();
+    if (L.n == 0) return;
+    // 1. Chordal yaw.
+    {
+      detail::BlockSystem<2> sys;
+      sys.build(L.n, L.pairs);
+      sys.set_zero();
+      for (std::size_t k = 0; k < edges_.size(); ++k) {
+        const int i = ends_[k].first, j = ends_[k].second;
+        const double w = std::max(edges_[k].information(3, 3), 0.0);
+        const Eigen::Matrix2d Rk = SO2<double>(edges_[k].dyaw).matrix();
+        // r = v_j - Rk v_i; J_i = -Rk, J_j = I.
+        const Eigen::Vector2d vi = unit(poses_[std::size_t(i)].yaw);
+        const Eigen::Vector2d vj = unit(poses_[std::size_t(j)].yaw);
+        const Eigen::Vector2d r0 = vj - Rk * vi;  // at the current point
+        const Eigen::Matrix2d Hii = w * Eigen::Matrix2d::Identity();
+        const Eigen::Matrix2d Hij = -w * Rk.transpose();
+        sys.add(k, Hii, Hij, w * Eigen::Matrix2d::Identity(), -w * Rk.transpose() * r0, w * r0);
+      }
+      const Eigen::VectorXd dx = solve(sys, "yaw initialisation");
+      for (std::size_t a = 0; a < poses_.size(); ++a) {
+        const int v = L.var[a];
+        if (v < 0) continue;
+        const Eigen::Vector2d u = unit(poses_[a].yaw) + dx.segment<2>(2 * v);
+        if (u.norm() > 1e-12) poses_[a].yaw = wrap_angle(std::atan2(u.y(), u.x()));
+      }
+    }
+    // 2. Linear translation solve.
+    {
+      detail::BlockSystem<3> sys;
+      sys.build(L.n, L.pairs);
+      sys.set_zero();
+      for (std::size_t k = 0; k < edges_.size(); ++k) {
+        const int i = ends_[k].first, j = ends_[k].second;
+        const Edge4Dof& ed = edges_[k];
+        Eigen::Matrix4d Ji, Jj;
+        const Eigen::Vector4d e = edge_error_4dof(poses_[std::size_t(i)].p, poses_[std::size_t(i)].yaw,
+                                                  Qt_[std::size_t(i)], poses_[std::size_t(j)].p,
+                                                  poses_[std::size_t(j)].yaw, ed.dp, ed.dyaw, &Ji, &Jj);
+        const Eigen::Matrix3d Jpi = Ji.topLeftCorner<3, 3>(), Jpj = Jj.topLeftCorner<3, 3>();
+        const Eigen::Matrix<double, 3, 4> Om = ed.information.topRows<3>();
+        const Eigen::Matrix3d Ott = ed.information.topLeftCorner<3, 3>();
+        const Eigen::Vector3d g = Om * e;  // Ω_tt e_t + Ω_tψ e_ψ
+        sys.add(k, Jpi.transpose() * Ott * Jpi, Jpi.transpose() * Ott * Jpj, Jpj.transpose() * Ott * Jpj,
+                Jpi.transpose() * g, Jpj.transpose() * g);
+      }
+      const Eigen::VectorXd dx = solve(sys, "translation initialisation");
+      for (std::size_t a = 0; a < poses_.size(); ++a) {
+        const int v = L.var[a];
+        if (v >= 0) poses_[a].p += dx.segment<3>(3 * v);
+      }
+    }
+  }
+
+  /// Minimises the cost over the free nodes' x, y, z and yaw.
+  ///
+  /// Each iteration linearises every edge (analytic Jacobians of
+  /// edge_error_4dof), weights it by \f$ \rho'(s) \f$ (IRLS), assembles
+  /// \f$ H = \sum J^\top \rho' \Omega J \f$ and \f$ b = \sum J^\top \rho' \Omega e \f$
+  /// in 4x4 blocks, and solves \f$ (H + \lambda\,\mathrm{diag}(H)) \Delta = -b \f$
+  /// with a block sparse Cholesky (detail/block_system.hpp: 4x4 blocks,
+  /// block AMD ordering and symbolic analysis computed once per call). LM adapts
+  /// \f$ \lambda \f$ by the gain ratio (Nielsen's rule); a step is taken only
+  /// when it lowers the cost. When no node is fixed, the first is held fixed.
+  /// @throws posefuse::invalid_argument as validate()
+  PoseGraphSummary optimize(const PoseGraphOptions& options = {}) {
+    const auto t0 = std::chrono::steady_clock::now();
+    validate();
+    PoseGraphSummary s;
+    const Layout L = layout();
+    s.initial_cost = s.final_cost = cost();
+    if (L.n == 0 || edges_.empty()) {
+      s.termination = Termination::kGradientTolerance;
+      s.solve_time_s = seconds_since(t0);
+      return s;
+    }
+    detail::BlockSystem<4> sys;
+    sys.build(L.n, L.pairs);
+    detail::BlockCholesky<4> chol;
+    chol.analyze(sys);
+    double cost_now = s.initial_cost;
+    double lambda = options.levenberg_marquardt ? options.initial_lambda : 0.0;
+    double nu = 2.0;
+    bool relinearise = true;
+    Eigen::VectorXd diag;
+    std::vector<Pose4Dof> trial;
+    s.termination = Termination::kMaxIterations;
+    while (s.iterations < options.max_iterations) {
+      if (relinearise) {
+        assemble(sys);
+        diag = sys.diagonal();
+        if (sys.b.lpNorm<Eigen::Infinity>() < options.gradient_tolerance) {
+          s.termination = Termination::kGradientTolerance;
+          break;
+        }
+        relinearise = false;
+      }
+      ++s.iterations;
+      Eigen::VectorXd delta = Eigen::VectorXd::Zero(diag.size());
+      if (lambda > 0) {
+        for (Eigen::Index c = 0; c < diag.size(); ++c)
+          delta(c) = lambda * std::clamp(diag(c), 1e-6, 1e32);
+        sys.add_to_diagonal(delta);
+      }
+      const bool factored = chol.factorize(sys);
+      Eigen::VectorXd dx;
+      if (factored) dx = chol.solve(-sys.b);
+      if (lambda > 0) sys.add_to_diagonal(-delta);
+      if (!factored || !dx.allFinite()) {
+        if (!options.levenberg_marquardt) {
+          s.termination = Termination::kNoProgress;
+          break;
+        }
+        lambda = std::max(lambda, 1e-8) * nu;
+        nu *= 2;
+        if (lambda > 1e16) {
+          s.termination = Termination::kNoProgress;
+          break;
+        }
+        continue;
+      }
+      trial = poses_;
+      apply_step(L, dx, trial);
+      const double cost_new = cost_at(trial);
+      // Predicted decrease of the quadratic model of F = Σ ρ(s): -(2 Δᵀb + Δᵀ H Δ).
+      const double predicted = -(2.0 * dx.dot(sys.b) + sys.quadratic_form(dx));
+      // Near the minimum the cost change drops below its rounding error
+      // (F ~ 3 moves by 1e-20 when a pose moves by 1e-10): a step whose
+      // predicted decrease is at rounding level is taken once (the quadratic
+      // model is exact there) and the optimiser stops.
+      const double rounding = 64.0 * std::numeric_limits<double>::epsilon() * cost_now;
+      const bool polish = std::isfinite(cost_new) && !(cost_new < cost_now) && predicted >= 0 &&
+                          predicted <= rounding && cost_new <= cost_now + rounding;
+      if (polish) {
+        poses_.swap(trial);
+        ++s.accepted;
+        cost_now = std::min(cost_now, cost_new);
+        s.termination = Termination::kFunctionTolerance;
+        break;
+      }
+      if (std::isfinite(cost_new) && cost_new < cost_now) {
+        const double rho = predicted > 0 ? (cost_now - cost_new) / predicted : 1.0;
+        const double decrease = cost_now - cost_new;
+        poses_.swap(trial);
+        ++s.accepted;
+        relinearise = true;
+        if (options.levenberg_marquardt) {
+          const double f = 2.0 * rho - 1.0;
+          lambda *= std::max(1.0 / 3.0, 1.0 - f * f * f);
+          lambda = std::max(lambda, 1e-12);
+          nu = 2.0;
+        }
+        const double prev = cost_now;
+        cost_now = cost_new;
+        if (decrease < options.function_tolerance * prev) {
+          s.termination = Termination::kFunctionTolerance;
+          break;
+        }
+        if (dx.norm() < options.parameter_tolerance * (state_norm(L) + options.parameter_tolerance)) {
+          s.termination = Termination::kParameterTolerance;
+          break;
+        }
+      } else {
+        if (!options.levenberg_marquardt) {
+          s.termination = Termination::kNoProgress;
+          break;
+        }
+        // A step that does not lower the cost but is below the parameter
+        // tolerance means we are at the minimum to rounding.
+        if (dx.norm() < options.parameter_tolerance * (state_norm(L) + options.parameter_tolerance)) {
+          s.termination = Termination::kParameterTolerance;
+          break;
+        }
+        lambda *= nu;
+        nu *= 2;
+        if (lambda > 1e16) {
+          s.termination = Termination::kNoProgress;
+          break;
+        }
+      }
+    }
+    s.final_cost = cost_now;
+    s.solve_time_s = seconds_since(t0);
+    return s;
+  }
+
+ private:
+  struct Layout {
+    int n = 0;                               ///< free nodes
+    std::vector<int> var;                    ///< node → block column (-1 fixed)
+    std::vector<std::pair<int, int>> pairs;  ///< edge → block columns of its ends
+  };
+
+  [[nodiscard]] int node_index(std::int64_t id) const {
+    const auto it = index_.find(id);
+    if (it == index_.end()) throw invalid_argument("pose graph: node " + std::to_string(id) + " does not exist");
+    return it->second;
+  }
+
+  [[nodiscard]] std::vector<char> effective_fixed() const {
+    std::vector<char> f = fixed_;
+    if (!f.empty() && std::find(f.begin(), f.end(), char(1)) == f.end()) f[0] = 1;
+    return f;
+  }
+
+  [[nodiscard]] Layout layout() const {
+    Layout L;
+    const std::vector<char> fixed = effective_fixed();
+    std::vector<int> free_index(poses_.size(), -1);
+    for (std::size_t a = 0; a < poses_.size(); ++a)
+      if (!fixed[a]) free_index[a] = L.n++;
+    std::vector<std::pair<int, int>> raw;
+    raw.reserve(ends_.size());
+    for (const auto& e : ends_)
+      raw.emplace_back(free_index[std::size_t(e.first)], free_index[std::size_t(e.second)]);
+    const std::vector<int> pos = detail::block_amd_order(L.n, raw);
+    L.var.assign(poses_.size(), -1);
+    for (std::size_t a = 0; a < poses_.size(); ++a)
+      if (free_index[a] >= 0) L.var[a] = pos[std::size_t(free_index[a])];
+    L.pairs.reserve(ends_.size());
+    for (const auto& e : ends_) L.pairs.emplace_back(L.var[std::size_t(e.first)], L.var[std::size_t(e.second)]);
+    return L;
+  }
+
+  [[nodiscard]] static Eigen::Vector2d unit(double a) { return Eigen::Vector2d(std::cos(a), std::sin(a)); }
+
+  [[nodiscard]] static double seconds_since(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+
+  template <int B>
+  [[nodiscard]] static Eigen::VectorXd solve(detail::BlockSystem<B>& sys, const char* what) {
+    detail::BlockCholesky<B> chol;
+    chol.analyze(sys);
+    const bool factored = chol.factorize(sys);
+    Eigen::VectorXd dx;
+    if (factored) dx = chol.solve(-sys.b);
+    if (!factored || !dx.allFinite())
+      throw invalid_argument(std::string("pose graph: ") + what +
+                             ": the linear system is singular (information too weak to fix every node)");
+    return dx;
+  }
+
+  [[nodiscard]] double cost_at(const std::vector<Pose4Dof>& x) const {
+    double F = 0.0;
+    for (std::size_t k = 0; k < edges_.size(); ++k) {
+      const int i = ends_[k].first, j = ends_[k].second;
+      const Edge4Dof& ed = edges_[k];
+      const Eigen::Vector4d e = edge_error_4dof(x[std::size_t(i)].p, x[std::size_t(i)].yaw, Qt_[std::size_t(i)],
+                                                x[std::size_t(j)].p, x[std::size_t(j)].yaw, ed.dp, ed.dyaw);
+      F += ed.loss.rho(e.dot(ed.information * e));
+    }
+    return F;
+  }
+
+  void assemble(detail::BlockSystem<4>& sys) const {
+    sys.set_zero();
+    for (std::size_t k = 0; k < edges_.size(); ++k) {
+      const int i = ends_[k].first, j = ends_[k].second;
+      const Edge4Dof& ed = edges_[k];
+      Eigen::Matrix4d Ji, Jj;
+      const Eigen::Vector4d e =
+          edge_error_4dof(poses_[std::size_t(i)].p, poses_[std::size_t(i)].yaw, Qt_[std::size_t(i)],
+                          poses_[std::size_t(j)].p, poses_[std::size_t(j)].yaw, ed.dp, ed.dyaw, &Ji, &Jj);
+      const Eigen::Vector4d Oe = ed.information * e;
+      const double w = ed.loss.weight(e.dot(Oe));
+      const Eigen::Matrix4d WOJi = w * (ed.information * Ji);
+      const Eigen::Matrix4d WOJj = w * (ed.information * Jj);
+      sys.add(k, Ji.transpose() * WOJi, Ji.transpose() * WOJj, Jj.transpose() * WOJj,
+              w * (Ji.transpose() * Oe), w * (Jj.transpose() * Oe));
+    }
+  }
+
+  void apply_step(const Layout& L, const Eigen::VectorXd& dx, std::vector<Pose4Dof>& x) const {
+    for (std::size_t a = 0; a < x.size(); ++a) {
+      const int v = L.var[a];
+      if (v < 0) continue;
+      x[a].p += dx.segment<3>(4 * v);
+      x[a].yaw = wrap_angle(x[a].yaw + dx(4 * v + 3));
+    }
+  }
+
+  [[nodiscard]] double state_norm(const Layout& L) const {
+    double s = 0.0;
+    for (std::size_t a = 0; a < poses_.size(); ++a)
+      if (L.var[a] >= 0) s += poses_[a].p.squaredNorm() + poses_[a].yaw * poses_[a].yaw;
+    return std::sqrt(s);
+  }
+
+  std::vector<std::int64_t> ids_;
+  std::vector<Pose4Dof> poses_;
+  std::vector<Eigen::Matrix3d> Qt_;  ///< \f$ Q_i^\top \f$ per node
+  std::vector<char> fixed_;
+  std::unordered_map<std::int64_t, int> index_;
+  std::vector<Edge4Dof> edges_;
+  std::vector<std::pair<int, int>> ends_;  ///< node indices of each edge
+};
+
+}  // namespace posefuse
