@@ -140,9 +140,10 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
                  throw apps::usage_error("expected ape or rpe, got '" + std::string(v) + "'");
                o.metric_rpe = v == "rpe";
              });
-  cli.custom({.name = "--align", .value = "none|se3|sim3|scale",
-              .help = "Umeyama alignment of EST to REF (scale: scale only,\n"
-                      "evo's --correct_scale without --align)",
+  cli.custom({.name = "--align", .value = "none|se3|sim3|scale|posyaw",
+              .help = "alignment of EST to REF: Umeyama (scale: scale only, evo's\n"
+                      "--correct_scale without --align), or posyaw: position and yaw\n"
+                      "(4-DoF, roll and pitch errors stay visible)",
               .default_text = "none"},
              [&](std::string_view v) { o.align.alignment = posefuse::parse_alignment(v); });
   cli.flag({.name = "--align-origin", .help = "move EST so that its first pose is REF's first pose"},
@@ -226,7 +227,7 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
     throw apps::usage_error("--align-origin and --align exclude each other");
   if (n_to_align) {
     if (o.align.alignment == posefuse::Alignment::kNone)
-      throw apps::usage_error("--n-to-align needs --align se3, sim3 or scale");
+      throw apps::usage_error("--n-to-align needs --align se3, sim3, scale or posyaw");
     o.align.n_to_align = *n_to_align;
   }
   if (t_start && t_end && *t_start > *t_end)

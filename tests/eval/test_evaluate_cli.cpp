@@ -168,6 +168,10 @@ TEST_CASE("Evaluate CLI: evo options reach the library unchanged", "[eval][cli][
     a.n_to_align = 50;
     CHECK(rmse_of("--align se3 --n-to-align 50") ==
           posefuse::ape(sync.ref, sync.est, posefuse::PoseRelation::kTranslation, a).stats.rmse);
+    a.alignment = posefuse::Alignment::kPosYaw;
+    a.n_to_align = 0;
+    CHECK(rmse_of("--align posyaw") ==
+          posefuse::ape(sync.ref, sync.est, posefuse::PoseRelation::kTranslation, a).stats.rmse);
     a = {};
     a.align_origin = true;
     CHECK(rmse_of("--align-origin") ==

@@ -528,3 +528,31 @@ TEST_CASE("Metrics: projection to a plane keeps the angle about its normal", "[e
   CHECK(posefuse::ape(ref, est, PoseRelation::kTranslation, a).stats.max < 1e-15);
   CHECK(posefuse::ape(ref, est, PoseRelation::kRotationAngleRad, a).stats.max < 1e-7);
 }
+
+TEST_CASE("Metrics: posyaw alignment recovers a 4-DoF transform and leaves roll/pitch visible",
+          "[eval][metrics][evo-options]") {
+  // A z-up drive with height changes, so that a tilt shows in the positions.
+  posefuse::Trajectory ref;
+  for (int k = 0; k < 80; ++k) {
+    const double a = 0.08 * k;
+    ref.push_back(k, yaw_z(a + 1.2, {20 * std::cos(a), 12 * std::sin(a), 2 * std::sin(3 * a)}));
+  }
+  const Eigen::Isometry3d T4 = yaw_z(2.1, {-7, 3, 1.5});  // a 4-DoF transform
+  posefuse::Trajectory est = ref;
+  for (auto& P : est.poses) P = T4 * P;
+  const auto exact = posefuse::ape(ref, est, PoseRelation::kTranslation, posefuse::Alignment::kPosYaw);
+  CHECK(exact.stats.max < 1e-9);
+  CHECK(exact.alignment.rotation.isApprox(T4.linear().transpose(), 1e-12));
+  CHECK(posefuse::ape(ref, est, PoseRelation::kRotationAngleDeg, posefuse::Alignment::kPosYaw).stats.max < 1e-9);
+  // A 2-degree roll of the whole estimate: SE(3) alignment absorbs it,
+  // position + yaw cannot, so the roll error stays in the rotation APE.
+  const Eigen::Isometry3d roll(Eigen::AngleAxisd(2.0 * std::numbers::pi / 180.0, Eigen::Vector3d::UnitX()));
+  for (auto& P : est.poses) P = roll * P;
+  const auto se3 = posefuse::ape(ref, est, PoseRelation::kRotationAngleDeg, posefuse::Alignment::kSE3);
+  const auto posyaw = posefuse::ape(ref, est, PoseRelation::kRotationAngleDeg, posefuse::Alignment::kPosYaw);
+  CHECK(se3.stats.max < 1e-6);
+  CHECK(posyaw.stats.min == Approx(2.0).epsilon(1e-3));
+  CHECK(posyaw.stats.max == Approx(2.0).epsilon(1e-3));
+  CHECK(posefuse::parse_alignment("posyaw") == posefuse::Alignment::kPosYaw);
+  CHECK(posefuse::to_string(posefuse::Alignment::kPosYaw) == "posyaw");
+}

@@ -26,9 +26,12 @@ enum class Alignment {
   kSE3,   ///< rotation + translation (evo `--align`)
   kSim3,  ///< rotation + translation + scale (evo `--align --correct_scale`), for monocular SLAM
   kScale,  ///< scale only: positions multiplied by Umeyama's scale (evo `--correct_scale` alone)
+  /// position and yaw about the world z axis (4-DoF, for visual-inertial
+  /// estimates whose roll and pitch are observable; evo has no such mode)
+  kPosYaw,
 };
 
-/// Parses "none", "se3", "sim3" or "scale".
+/// Parses "none", "se3", "sim3", "scale" or "posyaw".
 /// @throws posefuse::invalid_argument for any other text
 template <class Lazy = void>
 [[nodiscard]] Alignment parse_alignment(std::string_view name) {
@@ -36,8 +39,9 @@ template <class Lazy = void>
   if (name == "se3") return Alignment::kSE3;
   if (name == "sim3") return Alignment::kSim3;
   if (name == "scale") return Alignment::kScale;
+  if (name == "posyaw") return Alignment::kPosYaw;
   throw invalid_argument("unknown alignment '" + std::string(name) +
-                         "' (expected none, se3, sim3 or scale)");
+                         "' (expected none, se3, sim3, scale or posyaw)");
 }
 
 /// The name `parse_alignment` accepts for `alignment`.
@@ -47,6 +51,7 @@ template <class Lazy = void>
     case Alignment::kSE3: return "se3";
     case Alignment::kSim3: return "sim3";
     case Alignment::kScale: return "scale";
+    case Alignment::kPosYaw: return "posyaw";
   }
   return "?";
 }
@@ -161,48 +166,6 @@ struct AlignedTrajectory {
   AlignmentResult transform;  ///< \f$ (R, t, c) \f$ used
 };
 
-/// Aligns `est` to `ref` over their (already associated) positions, as
-/// evo's `align_trajectory(est, ref, correct_scale, correct_only_scale, n)`.
-/// @param[in] est estimate, pose k registered to `ref` pose k
-/// @param[in] ref reference
-/// @param[in] alignment kNone (returns `est` and the identity), kSE3, kSim3,
-///            or kScale (Umeyama's Sim(3) scale applied to the positions
-///            alone, rotation and translation left as they are)
-/// @param[in] n_to_align use only the first `n_to_align` pose pairs to
-///            compute the alignment (evo `--n_to_align`); 0 means all
-/// @return the aligned estimate (every pose moved) and the similarity
-/// @throws posefuse::invalid_argument for different sizes, `n_to_align`
-///         larger than the poses, or the degenerate cases of `umeyama_alignment`
-template <class Lazy = void>
-[[nodiscard]] AlignedTrajectory align_trajectory(const Trajectory& est,
-                                                 const Trajectory& ref,
-                                                 Alignment alignment,
-                                                 std::size_t n_to_align = 0) {
-  if (est.size() != ref.size()) {
-    throw invalid_argument("align_trajectory: estimate has " + std::to_string(est.size()) +
-                           " poses but reference has " + std::to_string(ref.size()) +
-                           " (call associate() first)");
-  }
-  if (n_to_align > est.size()) {
-    throw invalid_argument("align_trajectory: " + std::to_string(n_to_align) +
-                           " poses to align requested but only " + std::to_string(est.size()) +
-                           " are associated");
-  }
-  if (alignment == Alignment::kNone) return {est, AlignmentResult{}};
-  std::vector<Eigen::Vector3d> x = est.positions();
-  std::vector<Eigen::Vector3d> y = ref.positions();
-  if (n_to_align > 0) {
-    x.resize(n_to_align);
-    y.resize(n_to_align);
-  }
-  AlignmentResult a = umeyama_alignment(x, y, alignment != Alignment::kSE3);
-  if (alignment == Alignment::kScale) {
-    a.rotation = Eigen::Matrix3d::Identity();
-    a.translation = Eigen::Vector3d::Zero();
-  }
-  return {apply_alignment(est, a), a};
-}
-
 /// Least-squares 4-DoF alignment: position and yaw only (rotation about the
 /// world z axis), for visual-inertial estimates whose roll and pitch are
 /// observable from gravity (VINS-Mono, Qin et al. 2018; evo has no such mode).
@@ -256,10 +219,57 @@ template <class Lazy = void>
   if (est.size() != ref.size())
     throw invalid_argument("align_posyaw: estimate has " + std::to_string(est.size()) +
                            " poses but reference has " + std::to_string(ref.size()) +
-                           " (associate them first)");
+                           " (call associate() first)");
   const std::vector<Eigen::Vector3d> x = est.positions();
   const std::vector<Eigen::Vector3d> y = ref.positions();
   const AlignmentResult a = posyaw_alignment(x, y);
+  return {apply_alignment(est, a), a};
+}
+
+/// Aligns `est` to `ref` over their (already associated) positions, as
+/// evo's `align_trajectory(est, ref, correct_scale, correct_only_scale, n)`.
+/// @param[in] est estimate, pose k registered to `ref` pose k
+/// @param[in] ref reference
+/// @param[in] alignment kNone (returns `est` and the identity), kSE3, kSim3,
+///            kScale (Umeyama's Sim(3) scale applied to the positions
+///            alone, rotation and translation left as they are) or kPosYaw
+///            (position and yaw, `posyaw_alignment`)
+/// @param[in] n_to_align use only the first `n_to_align` pose pairs to
+///            compute the alignment (evo `--n_to_align`); 0 means all
+/// @return the aligned estimate (every pose moved) and the similarity
+/// @throws posefuse::invalid_argument for different sizes, `n_to_align`
+///         larger than the poses, or the degenerate cases of `umeyama_alignment`
+template <class Lazy = void>
+[[nodiscard]] AlignedTrajectory align_trajectory(const Trajectory& est,
+                                                 const Trajectory& ref,
+                                                 Alignment alignment,
+                                                 std::size_t n_to_align = 0) {
+  if (est.size() != ref.size()) {
+    throw invalid_argument("align_trajectory: estimate has " + std::to_string(est.size()) +
+                           " poses but reference has " + std::to_string(ref.size()) +
+                           " (call associate() first)");
+  }
+  if (n_to_align > est.size()) {
+    throw invalid_argument("align_trajectory: " + std::to_string(n_to_align) +
+                           " poses to align requested but only " + std::to_string(est.size()) +
+                           " are associated");
+  }
+  if (alignment == Alignment::kNone) return {est, AlignmentResult{}};
+  std::vector<Eigen::Vector3d> x = est.positions();
+  std::vector<Eigen::Vector3d> y = ref.positions();
+  if (n_to_align > 0) {
+    x.resize(n_to_align);
+    y.resize(n_to_align);
+  }
+  if (alignment == Alignment::kPosYaw) {
+    const AlignmentResult a = posyaw_alignment(x, y);
+    return {apply_alignment(est, a), a};
+  }
+  AlignmentResult a = umeyama_alignment(x, y, alignment != Alignment::kSE3);
+  if (alignment == Alignment::kScale) {
+    a.rotation = Eigen::Matrix3d::Identity();
+    a.translation = Eigen::Vector3d::Zero();
+  }
   return {apply_alignment(est, a), a};
 }
 
