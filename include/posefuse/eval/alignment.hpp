@@ -206,7 +206,8 @@ template <class Lazy = void>
     throw invalid_argument("posyaw_alignment: the points have no horizontal spread; the yaw is undefined");
   const double psi = std::atan2(S, C);
   AlignmentResult r;
-  r.rotation = Eigen::AngleAxisd(psi, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const double c = std::cos(psi), s = std::sin(psi);
+  r.rotation << c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0;  // R_z(ψ)
   r.translation = my - r.rotation * mx;
   return r;
 }
