@@ -52,11 +52,15 @@
 /// random walks add \f$ \sigma_b^2\,\delta t\,I \f$. The covariance is
 /// \f$ P' = F P F^\top + G Q G^\top \f$ from \f$ P = 0 \f$ (VINS-Mono eq 11).
 ///
-/// **Cost.** The update exploits the structure (most of F is identity or zero,
-/// the bias-bias blocks stay scalar × I, the noise term has the closed form
-/// below); `DensePreintegration` in examples/apps/dense_preintegration.hpp forms the
-/// 15x15 F and 15x18 G and multiplies them (VINS-Mono's way), and a test
-/// checks both agree to 1e-12.
+/// **Cost.** The update exploits the structure: internally the rotation
+/// error is the left perturbation in frame i, \f$ \theta = \Delta R\,\delta\phi \f$
+/// (so its transition is the identity and \f$ \partial\bar u/\partial\theta = -[\bar u]_\times \f$),
+/// only the non-zero 3x3 blocks of P are stored (the bias-bias blocks stay
+/// scalar × I, Cov(θ, b_a) stays 0), the noise term has a closed form, and
+/// the result is converted to δφ when read (covariance(), bias_jacobian()).
+/// `DensePreintegration` in examples/apps/dense_preintegration.hpp forms the
+/// 15x15 F and 15x18 G in the δφ form and multiplies them (VINS-Mono's way);
+/// a test checks both agree to 1e-12.
 ///
 /// **Bias Jacobians** \f$ J = \partial[\Delta p, \Delta\phi, \Delta v] / \partial[b_a, b_g] \f$
 /// propagate as \f$ J' = F_x J + F_b \f$ from 0 (the top-right 9x6 block of the
