@@ -45,6 +45,25 @@ ImuState perturbed(const ImuState& x, double scale, std::mt19937_64& rng) {
 
 }  // namespace
 
+TEST_CASE("ImuState and ImuDelta: plus and minus are consistent (manifold conformance)",
+          "[inertial][conformance]") {
+  const Fixture f;
+  std::mt19937_64 rng(5);
+  for (int trial = 0; trial < 20; ++trial) {
+    const ImuState x = perturbed(f.truth(std::size_t(trial) * 10), 0.5, rng);
+    std::normal_distribution<double> n(0.0, 0.7);
+    ImuState::Tangent d;
+    for (int i = 0; i < 15; ++i) d(i) = n(rng);
+    const auto r = posefuse::testing::check_manifold(x, d, 1e-9);
+    INFO(r.message);
+    CHECK(r);
+    const posefuse::ImuDelta delta = f.pre.delta();
+    const auto r2 = posefuse::testing::check_manifold(delta, posefuse::ImuDelta::Tangent(d.head<9>()), 1e-9);
+    INFO(r2.message);
+    CHECK(r2);
+  }
+}
+
 TEST_CASE("ImuFactor: zero residual at its prediction, small at the truth", "[inertial][factor]") {
   const Fixture f;
   const ImuFactor factor(f.pre, f.gravity());
