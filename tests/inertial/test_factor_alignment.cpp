@@ -215,3 +215,22 @@ TEST_CASE("Alignment: reports insufficient excitation instead of a scale", "[ine
   CHECK(r.status == posefuse::AlignmentStatus::kInsufficientExcitation);
   CHECK(r.accel_std < 0.25);
 }
+
+TEST_CASE("Alignment: reports a gravity norm far from the configured one and a negative scale",
+          "[inertial][alignment]") {
+  posefuse::sim::ImuSimConfig c;
+  AlignmentCase a(c);
+  posefuse::AlignmentOptions o;
+  o.gravity_norm = 5.0;  // the data says 9.81
+  auto pre = a.pre;
+  const auto r = posefuse::align_visual_inertial<kFrames>(a.T_c0_c, a.T_b_c, pre, o);
+  CHECK(r.status == posefuse::AlignmentStatus::kGravityNorm);
+  CHECK(r.gravity_norm_unrefined == Approx(9.81).epsilon(0.01));
+  // Mirrored SfM positions: the only fit has a negative scale.
+  std::array<posefuse::SE3d, kFrames> mirrored = a.T_c0_c;
+  for (posefuse::SE3d& T : mirrored) T = posefuse::SE3d(-T.translation(), T.so3());
+  pre = a.pre;
+  const auto r2 = posefuse::align_visual_inertial<kFrames>(mirrored, a.T_b_c, pre);
+  INFO("scale " << r2.scale);
+  CHECK(r2.status == posefuse::AlignmentStatus::kNonPositiveScale);
+}
