@@ -45,6 +45,25 @@ ImuState perturbed(const ImuState& x, double scale, std::mt19937_64& rng) {
 
 }  // namespace
 
+TEST_CASE("ImuState and ImuDelta: plus and minus are consistent (manifold conformance)",
+          "[inertial][conformance]") {
+  const Fixture f;
+  std::mt19937_64 rng(5);
+  for (int trial = 0; trial < 20; ++trial) {
+    const ImuState x = perturbed(f.truth(std::size_t(trial) * 10), 0.5, rng);
+    std::normal_distribution<double> n(0.0, 0.7);
+    ImuState::Tangent d;
+    for (int i = 0; i < 15; ++i) d(i) = n(rng);
+    const auto r = posefuse::testing::check_manifold(x, d, 1e-9);
+    INFO(r.message);
+    CHECK(r);
+    const posefuse::ImuDelta delta = f.pre.delta();
+    const auto r2 = posefuse::testing::check_manifold(delta, posefuse::ImuDelta::Tangent(d.head<9>()), 1e-9);
+    INFO(r2.message);
+    CHECK(r2);
+  }
+}
+
 TEST_CASE("ImuFactor: zero residual at its prediction, small at the truth", "[inertial][factor]") {
   const Fixture f;
   const ImuFactor factor(f.pre, f.gravity());
@@ -195,4 +214,23 @@ TEST_CASE("Alignment: reports insufficient excitation instead of a scale", "[ine
   INFO("accel std " << r.accel_std);
   CHECK(r.status == posefuse::AlignmentStatus::kInsufficientExcitation);
   CHECK(r.accel_std < 0.25);
+}
+
+TEST_CASE("Alignment: reports a gravity norm far from the configured one and a negative scale",
+          "[inertial][alignment]") {
+  posefuse::sim::ImuSimConfig c;
+  AlignmentCase a(c);
+  posefuse::AlignmentOptions o;
+  o.gravity_norm = 5.0;  // the data says 9.81
+  auto pre = a.pre;
+  const auto r = posefuse::align_visual_inertial<kFrames>(a.T_c0_c, a.T_b_c, pre, o);
+  CHECK(r.status == posefuse::AlignmentStatus::kGravityNorm);
+  CHECK(r.gravity_norm_unrefined == Approx(9.81).epsilon(0.01));
+  // Mirrored SfM positions: the only fit has a negative scale.
+  std::array<posefuse::SE3d, kFrames> mirrored = a.T_c0_c;
+  for (posefuse::SE3d& T : mirrored) T = posefuse::SE3d(-T.translation(), T.so3());
+  pre = a.pre;
+  const auto r2 = posefuse::align_visual_inertial<kFrames>(mirrored, a.T_b_c, pre);
+  INFO("scale " << r2.scale);
+  CHECK(r2.status == posefuse::AlignmentStatus::kNonPositiveScale);
 }

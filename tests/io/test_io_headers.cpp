@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <posefuse/io/association.hpp>
+#include <posefuse/io/euroc.hpp>
 #include <posefuse/io/formats.hpp>
 #include <posefuse/io/kitti.hpp>
 #include <posefuse/core/plane.hpp>
