@@ -130,12 +130,82 @@ template <class T>
          std::numeric_limits<T>::epsilon();
 }
 
+/// The diagonal shift of psd_shifted_ldlt_accepts for size n, relative to
+/// each variance: \f$ \delta_n = 2\,(2 n(n+1) + 19 n + 3)\,\epsilon \f$
+/// (double: 3.4e-13 at n = 15; float: 1.8e-4 at n = 15).
+template <class T>
+[[nodiscard]] constexpr T psd_shift(int n) noexcept {
+  return T(2) * (T(2) * T(n) * T(n + 1) + T(19) * T(n) + T(3)) * std::numeric_limits<T>::epsilon();
+}
+
+/// The fast path of is_positive_semidefinite for fixed sizes above
+/// kPsdFastMaxSize: a sufficient condition for the reference (true only when
+/// psd_reference is certain to accept `m`, as definite); false means
+/// "undecided". After the checks of psd_fast_accepts (exact symmetry,
+/// variances in range), an unpivoted LDLT of the *shifted* matrix
+/// \f$ M - \delta_n D \f$ (\f$ D = \mathrm{diag}(M) \f$, psd_shift) must
+/// complete with positive pivots (Rump's verification of positive
+/// definiteness by a floating-point Cholesky of a shifted matrix: Rump,
+/// BIT 46 (2006) 433-452).
+///
+/// Why: the computed factors satisfy \f$ \hat L \hat D \hat L^\top = M - \delta_n
+/// D + \eta + \Delta M \f$ with \f$ |\Delta M| \le \gamma_{n+1} |\hat L|
+/// |\hat D| |\hat L^\top| \f$ (Higham, *Accuracy and Stability*, Thm 10.3
+/// and its LDLT form) and \f$ |\eta_{ii}| \le 2.1\,\epsilon\, m_{ii} \f$
+/// (rounding of the shifted diagonal). With positive pivots, Cauchy-Schwarz
+/// bounds \f$ (|\hat L||\hat D||\hat L^\top|)_{ij} \f$ by
+/// \f$ \sqrt{m_{ii} m_{jj}} (1 + 3\epsilon) / (1 - \gamma_{n+1}) \f$, so in
+/// the scale-free form C, \f$ C - \delta_n I + E \succeq 0 \f$ with
+/// \f$ \|E\|_2 \lesssim (n(n+1) + 2.1)\epsilon \f$, i.e. \f$ \lambda_{\min}(C)
+/// \gtrsim \delta_n - (n(n+1) + 2.1)\epsilon \f$. The reference's completely
+/// pivoted LDLT is exact for a matrix within \f$ (n(n+1) + 3n)\epsilon \f$
+/// of C (see psd_fast_accepts), so its pivots exceed \f$ \delta_n - (2n(n+1)
+/// + 3n + 2.1)\epsilon > 16 n \epsilon \f$, the tolerance, with a factor 2 to
+/// spare in \f$ \delta_n \f$: the reference accepts, as definite. The range of
+/// the variances keeps every rounding error relative (underflow in a product
+/// is far below \f$ \epsilon \sqrt{m_{ii} m_{jj}} \f$); an overflow, NaN or
+/// Inf makes a later pivot NaN or \f$ -\infty \f$, which fails.
+/// tests/filters/test_ekf_fast_paths.cpp checks the agreement with the
+/// reference on random PSD, indefinite and near-singular matrices.
+template <class Derived>
+[[nodiscard]] bool psd_shifted_ldlt_accepts(const Eigen::MatrixBase<Derived>& m) {
+  using T = typename Derived::Scalar;
+  constexpr int N = Derived::RowsAtCompileTime;
+  constexpr T delta = psd_shift<T>(N);
+  if constexpr (!(delta < T(0.5))) {
+    return false;
+  } else {
+    const T min_diag = std::sqrt(std::numeric_limits<T>::min()) / std::numeric_limits<T>::epsilon();
+    const T max_diag = std::sqrt(std::numeric_limits<T>::max()) * std::numeric_limits<T>::epsilon();
+    T s[N][N];  // lower triangle of the Schur complements of the shifted matrix
+    for (int i = 0; i < N; ++i) {
+      const T d = m(i, i);
+      if (!(d >= min_diag && d <= max_diag)) return false;
+      s[i][i] = d - delta * d;
+      for (int j = 0; j < i; ++j) {
+        if (!(m(i, j) == m(j, i))) return false;
+        s[i][j] = m(i, j);
+      }
+    }
+    for (int k = 0; k < N; ++k) {
+      const T d = s[k][k];
+      if (!(d > T(0))) return false;
+      const T inv = T(1) / d;
+      T l[N];
+      for (int i = k + 1; i < N; ++i) l[i] = s[i][k] * inv;
+      for (int i = k + 1; i < N; ++i)
+        for (int j = k + 1; j <= i; ++j) s[i][j] -= l[i] * s[j][k];
+    }
+    return true;
+  }
+}
+
 /// A sufficient condition for the criterion of is_positive_definite (and so
 /// of is_positive_semidefinite), cheaper than the reference: true only when
 /// the reference test (psd_reference) is certain to accept `m` as positive
 /// definite; false means "undecided", never "indefinite".
 ///
-/// For fixed sizes 1..6: `m` exactly symmetric, every diagonal entry in
+/// Sizes above 6 take psd_shifted_ldlt_accepts. For fixed sizes 1..6: `m` exactly symmetric, every diagonal entry in
 /// [sqrt(min) / eps, sqrt(max) * eps] (no overflow or underflow below), then
 /// an LDLT of `m` in its given order, without pivoting, square roots or any
 /// division but one per pivot, in which every pivot of the scale-free form,
@@ -164,8 +234,10 @@ template <class Derived>
   using T = typename Derived::Scalar;
   constexpr int N = Derived::RowsAtCompileTime;
   if constexpr (N == Eigen::Dynamic || N != Derived::ColsAtCompileTime || N < 1 ||
-                N > kPsdFastMaxSize || !std::is_floating_point_v<T>) {
+                !std::is_floating_point_v<T>) {
     return false;
+  } else if constexpr (N > kPsdFastMaxSize) {
+    return psd_shifted_ldlt_accepts(m);
   } else {
     constexpr T beta = psd_fast_min_pivot<T>(N);
     if constexpr (!(beta < T(1))) {
