@@ -480,10 +480,12 @@ void check_shifted_psd_path(std::mt19937& rng) {
 }
 }  // namespace
 
-TEST_CASE("is_positive_semidefinite: the shifted-LDLT fast path above 6x6 only accepts what the "
-          "reference accepts",
+TEST_CASE("is_positive_semidefinite: the minors (3x3, 4x4) and shifted-LDLT (above 6x6) fast paths "
+          "only accept what the reference accepts",
           "[filters][ekf][fast][psd]") {
   std::mt19937 rng(96);
+  check_shifted_psd_path<3>(rng);
+  check_shifted_psd_path<4>(rng);
   check_shifted_psd_path<7>(rng);
   check_shifted_psd_path<9>(rng);
   check_shifted_psd_path<12>(rng);

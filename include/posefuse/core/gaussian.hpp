@@ -191,12 +191,90 @@ template <class Derived>
       const T d = s[k][k];
       if (!(d > T(0))) return false;
       const T inv = T(1) / d;
-      T l[N];
-      for (int i = k + 1; i < N; ++i) l[i] = s[i][k] * inv;
-      for (int i = k + 1; i < N; ++i)
-        for (int j = k + 1; j <= i; ++j) s[i][j] -= l[i] * s[j][k];
+      T c[N];  // column k, contiguous so that the row updates vectorise
+      for (int j = k + 1; j < N; ++j) c[j] = s[j][k];
+      for (int i = k + 1; i < N; ++i) {
+        const T l = c[i] * inv;
+        for (int j = k + 1; j <= i; ++j) s[i][j] -= l * c[j];
+      }
     }
     return true;
+  }
+}
+
+/// Division-free first try of the fast path for sizes 3 and 4: Sylvester's
+/// criterion with margins. True only when the reference (psd_reference) is
+/// certain to accept `m` as definite; false means "undecided".
+///
+/// Checks: `m` exactly symmetric, every variance in \f$ [2^{-100}, 2^{100}] \f$,
+/// \f$ m_{ij}^2 \le m_{ii} m_{jj} \f$, then the leading principal minors
+/// \f$ D_k \f$ (cofactor / Laplace expansion) against \f$ \theta_k \prod_{i<k}
+/// m_{ii} \f$ with \f$ \theta_k = 12 k\,k!\,\epsilon \f$ for k < n and
+/// \f$ \theta_n = 12 n\,n!\,\epsilon + 3\delta_n \f$ (\f$ \delta_n \f$ = psd_shift).
+///
+/// Why: each expansion sums the k! Leibniz products, each after at most 3k
+/// roundings, so \f$ |\hat D_k - D_k| \le \gamma_{3k}\,\mathrm{per}|M_k| \le
+/// \gamma_{3k}\,k! \prod m_{ii} (1 + k\epsilon) \f$ (the permanent bounded by
+/// the entry check). Hence every exact leading minor is positive (Sylvester:
+/// M, and its scale-free form C, are positive definite) and
+/// \f$ \det C = D_n / \prod m_{ii} \ge 3\delta_n \f$ (to first order). The
+/// other n - 1 eigenvalues of C have a product at most
+/// \f$ (\mathrm{tr}\,C / (n-1))^{n-1} = (n/(n-1))^{n-1} < e \f$, so
+/// \f$ \lambda_{\min}(C) > \delta_n \f$, which (see psd_shifted_ldlt_accepts)
+/// makes the reference accept. The variance range keeps every product
+/// normal or its underflow far below the margins; NaN fails a comparison.
+template <class Derived>
+[[nodiscard]] bool psd_minors_accept(const Eigen::MatrixBase<Derived>& m) {
+  using T = typename Derived::Scalar;
+  constexpr int N = Derived::RowsAtCompileTime;
+  static_assert(N == 3 || N == 4);
+  constexpr T eps = std::numeric_limits<T>::epsilon();
+  constexpr T fact = N == 3 ? T(6) : T(24);
+  constexpr T theta3 = T(12 * 3 * 6) * eps + (N == 3 ? T(3) * psd_shift<T>(3) : T(0));
+  constexpr T theta4 = T(12 * 4 * 24) * eps + T(3) * psd_shift<T>(4);
+  constexpr T theta2 = T(12 * 2 * 2) * eps;
+  (void)fact;
+  if constexpr (!(theta3 < T(0.5) && theta4 < T(0.5))) {
+    return false;
+  } else {
+    const T lo = T(0x1p-100), hi = T(0x1p100);
+    T a[N][N];
+    for (int i = 0; i < N; ++i) {
+      a[i][i] = m(i, i);
+      if (!(a[i][i] >= lo && a[i][i] <= hi)) return false;
+    }
+    for (int i = 0; i < N; ++i)
+      for (int j = 0; j < i; ++j) {
+        const T v = m(i, j);
+        if (!(v == m(j, i) && v * v <= a[i][i] * a[j][j])) return false;
+        a[i][j] = a[j][i] = v;
+      }
+    const T p2 = a[0][0] * a[1][1];
+    const T d2 = p2 - a[0][1] * a[0][1];
+    if (!(d2 >= theta2 * p2)) return false;
+    // 2x2 minors of rows 0, 1 (columns c0 < c1).
+    const T m01 = d2;
+    const T m02 = a[0][0] * a[1][2] - a[0][2] * a[1][0];
+    const T m12 = a[0][1] * a[1][2] - a[0][2] * a[1][1];
+    const T d3 = a[2][0] * m12 - a[2][1] * m02 + a[2][2] * m01;
+    const T p3 = p2 * a[2][2];
+    if constexpr (N == 3) {
+      return d3 >= theta3 * p3;
+    } else {
+      if (!(d3 >= T(12 * 3 * 6) * eps * p3)) return false;
+      const T m03 = a[0][0] * a[1][3] - a[0][3] * a[1][0];
+      const T m13 = a[0][1] * a[1][3] - a[0][3] * a[1][1];
+      const T m23 = a[0][2] * a[1][3] - a[0][3] * a[1][2];
+      // Complementary 2x2 minors of rows 2, 3.
+      const T n23 = a[2][2] * a[3][3] - a[2][3] * a[3][2];
+      const T n13 = a[2][1] * a[3][3] - a[2][3] * a[3][1];
+      const T n12 = a[2][1] * a[3][2] - a[2][2] * a[3][1];
+      const T n03 = a[2][0] * a[3][3] - a[2][3] * a[3][0];
+      const T n02 = a[2][0] * a[3][2] - a[2][2] * a[3][0];
+      const T n01 = a[2][0] * a[3][1] - a[2][1] * a[3][0];
+      const T d4 = m01 * n23 - m02 * n13 + m03 * n12 + m12 * n03 - m13 * n02 + m23 * n01;
+      return d4 >= theta4 * (p3 * a[3][3]);
+    }
   }
 }
 
@@ -205,7 +283,8 @@ template <class Derived>
 /// the reference test (psd_reference) is certain to accept `m` as positive
 /// definite; false means "undecided", never "indefinite".
 ///
-/// Sizes above 6 take psd_shifted_ldlt_accepts. For fixed sizes 1..6: `m` exactly symmetric, every diagonal entry in
+/// Sizes above 6 take psd_shifted_ldlt_accepts; sizes 3 and 4 first try
+/// psd_minors_accept (no division). For fixed sizes 1..6: `m` exactly symmetric, every diagonal entry in
 /// [sqrt(min) / eps, sqrt(max) * eps] (no overflow or underflow below), then
 /// an LDLT of `m` in its given order, without pivoting, square roots or any
 /// division but one per pivot, in which every pivot of the scale-free form,
@@ -255,6 +334,9 @@ template <class Derived>
               m(1, 1) <= max_diag && m(1, 0) == m(0, 1)))
           return false;
         return m(1, 0) * m(1, 0) <= (T(1) - beta) * (m(0, 0) * m(1, 1));
+      }
+      if constexpr (N == 3 || N == 4) {
+        if (psd_minors_accept(m)) return true;  // else the LDLT below decides
       }
       constexpr T l2 = T(kPsdFastMaxMultiplier) * T(kPsdFastMaxMultiplier);
       T diag[N];

@@ -141,7 +141,7 @@ class SpdSolver {
 
  public:
   /// Factorises S. @return false (solver unusable) unless S is positive definite
-  [[nodiscard]] bool compute(const Mat& S) {
+  [[nodiscard, gnu::always_inline]] bool compute(const Mat& S) {
     if constexpr (N == 1) {
       if (!(S(0, 0) > T(0))) return false;
       inv_(0, 0) = T(1) / S(0, 0);
@@ -178,7 +178,7 @@ class SpdSolver {
     }
   }
   /// \f$ r^\top S^{-1} r = \|L^{-1} r\|^2 \f$.
-  [[nodiscard]] T nis(const Vec& r) const {
+  [[nodiscard, gnu::always_inline]] T nis(const Vec& r) const {
     if constexpr (N <= 2) {
       return r.dot(inv_ * r);
     } else {
@@ -195,7 +195,8 @@ class SpdSolver {
   }
   /// \f$ A S^{-1} \f$ for an M x N matrix A (rows solved with L, then L^T).
   template <int M>
-  [[nodiscard]] Eigen::Matrix<T, M, N> right_solve(const Eigen::Matrix<T, M, N>& A) const {
+  [[nodiscard, gnu::always_inline]] Eigen::Matrix<T, M, N> right_solve(
+      const Eigen::Matrix<T, M, N>& A) const {
     if constexpr (N <= 2) {
       return A * inv_;
     } else {
@@ -421,7 +422,7 @@ class BasicEkf {
       P_new = sandwich(F, Covariance(motion_.noise(x_, u, dt)));
       if constexpr (Options::kRecordJacobian) F_new = F;
     }
-    if (!minus(x_new, x_).allFinite()) return FilterStatus::kNonFinite;
+    if (!finite(minus(x_new, x_))) return FilterStatus::kNonFinite;
     mirror_lower(P_new);
     // Refuses NaN and Inf too; the finiteness pass runs only to name the failure.
     if (!is_positive_semidefinite(P_new))
@@ -560,7 +561,7 @@ class BasicEkf {
       // The covariance part depends on P alone: reuse it while P repeats
       // (a converged, steady-state filter), bit for bit what it would compute.
       GainMemo<H>& memo = std::get<I>(memos_);
-      if (!memo.valid || memo.P_in != P_) {
+      if (!memo.valid || !same_values(memo.P_in, P_)) {
         memo.valid = false;
         const FilterStatus s = covariance_update(sensor, memo.gain);
         if (s != FilterStatus::kApplied) return fail(UpdateResult<H>{}, s);
@@ -612,7 +613,7 @@ class BasicEkf {
   }
 
   template <class H>
-  FilterStatus covariance_update(const H& sensor, Gain<H>& g) const {
+  [[gnu::always_inline]] FilterStatus covariance_update(const H& sensor, Gain<H>& g) const {
     constexpr int M = DimOf<typename H::Measurement>;
     using SMat = typename Gain<H>::SMat;
     using HP = Eigen::Matrix<Scalar, M, Dim>;
@@ -634,7 +635,7 @@ class BasicEkf {
     }
     if (!g.S_solver.compute(g.S)) return FilterStatus::kNotPositiveDefinite;
     g.K = g.S_solver.right_solve(Nm(JP.transpose()));  // P H^T S^-1
-    const Covariance A = P_ - g.K * JP;                 // (I - K H) P
+    const Covariance A = P_ - g.K.lazyProduct(JP);      // (I - K H) P
     if constexpr (Options::kCovarianceUpdate == CovarianceUpdate::kStandard) {
       g.P_post = A;
       mirror_lower(g.P_post);
@@ -647,7 +648,7 @@ class BasicEkf {
       } else {
         AHt = A * J.transpose();
       }
-      const Nm C = g.K * R - AHt;
+      const Nm C = g.K.lazyProduct(R) - AHt;
       for (int j = 0; j < Dim; ++j) {
         for (int i = j; i < Dim; ++i) {
           Scalar v = A(i, j);
@@ -683,20 +684,20 @@ class BasicEkf {
   }
 
   template <class H, class Gate>
-  UpdateResult<H> apply_update(const H& sensor, const typename H::Measurement& z, Scalar nis_gate,
+  [[gnu::always_inline]] UpdateResult<H> apply_update(const H& sensor, const typename H::Measurement& z, Scalar nis_gate,
                                const Gate& gate, const Gain<H>& g) {
     using Z = typename H::Measurement;
     UpdateResult<H> out;
     out.S = g.S;
     out.innovation = minus(z, static_cast<Z>(sensor.predict(x_)));
-    if (!out.innovation.allFinite()) return out;  // kNonFinite
+    if (!finite(out.innovation)) return out;  // kNonFinite
     if (needs_nis<H, Gate>(nis_gate)) {
       out.nis = g.S_solver.nis(out.innovation);
       if (!(out.nis <= nis_gate)) return fail(out, FilterStatus::kGated);
     }
     if (!gate_accepts<H>(gate, out)) return fail(out, FilterStatus::kGated);
     const StateType x_new = plus(x_, TangentOf<StateType>(g.K * out.innovation));
-    if (!minus(x_new, x_).allFinite()) return fail(out, FilterStatus::kNonFinite);
+    if (!finite(minus(x_new, x_))) return fail(out, FilterStatus::kNonFinite);
     x_ = x_new;
     P_ = g.P_post;
     out.status = FilterStatus::kApplied;
@@ -721,15 +722,29 @@ class BasicEkf {
   }
 
   /// \f$ F P F^\top + Q \f$, lower triangle only (mirror_lower() completes it).
-  Covariance sandwich(const Covariance& F, const Covariance& Q) const {
-    const Covariance FP = F * P_;
+  [[gnu::always_inline]] Covariance sandwich(const Covariance& F, const Covariance& Q) const {
+    const Covariance FP = F.lazyProduct(P_);
     Covariance out;
     for (int j = 0; j < Dim; ++j)
       for (int i = j; i < Dim; ++i) out(i, j) = Q(i, j) + FP.row(i).dot(F.row(j));
     return out;
   }
+  /// Every entry equal (==) to the other's.
+  [[gnu::always_inline]] static bool same_values(const Covariance& a, const Covariance& b) noexcept {
+    for (int i = 0; i < Dim * Dim; ++i)
+      if (a.data()[i] != b.data()[i]) return false;
+    return true;
+  }
+  /// True when every entry is finite, in one branch-free pass: v - v is 0
+  /// for a finite entry and NaN for NaN or Inf.
+  template <int N>
+  [[gnu::always_inline]] static bool finite(const Eigen::Matrix<Scalar, N, 1>& v) noexcept {
+    Scalar s = Scalar(0);
+    for (int i = 0; i < N; ++i) s += v(i) - v(i);
+    return s == Scalar(0);
+  }
   /// Copies the lower triangle onto the upper one (exactly symmetric; no arithmetic).
-  static void mirror_lower(Covariance& P) noexcept {
+  [[gnu::always_inline]] static void mirror_lower(Covariance& P) noexcept {
     for (int j = 0; j < Dim; ++j)
       for (int i = j + 1; i < Dim; ++i) P(j, i) = P(i, j);
   }
