@@ -19,7 +19,7 @@
 ///
 /// **Solving with S.** For 1x1 and 2x2 innovations S is tested by
 /// Sylvester's criterion and inverted in closed form (a few flops). Larger
-/// ones are factorised, \f$ S = L L^\top \f$, and K and the NIS
+/// ones are factorised, \f$ S = L D L^\top \f$ (no square roots), and K and the NIS
 /// \f$ r^\top S^{-1} r \f$ are computed by solving with L; no inverse is
 /// formed. Either way S counts as positive definite only when every pivot is
 /// above round-off: \f$ L_{ii}^2 > n\,\epsilon\,S_{ii} \f$ (2x2:
@@ -133,7 +133,7 @@ consteval bool state_matches() {
 
 /// The positive-definiteness test and the solves with an innovation
 /// covariance S (see the file comment). Sizes 1 and 2 keep S⁻¹ in closed
-/// form; larger sizes keep the Cholesky factor and never form S⁻¹.
+/// form; larger sizes keep the factors of S = L D Lᵀ and never form S⁻¹.
 template <class Mat, int N = Mat::RowsAtCompileTime>
 class SpdSolver {
   using T = typename Mat::Scalar;
@@ -157,27 +157,27 @@ class SpdSolver {
       inv_(1, 0) = -S(1, 0) * r;
       return true;
     } else {
-      // S = L L^T, column by column (Cholesky-Banachiewicz), lower triangle
-      // of S only; 1 / L_ii kept so the solves below multiply.
+      // S = L D L^T (L unit lower triangular), column by column, from the
+      // lower triangle of S; no square roots, 1 / d_j kept so that the
+      // solves below multiply. d_j is the squared Cholesky pivot L_jj^2.
       const T tol = T(N) * std::numeric_limits<T>::epsilon();
       for (int j = 0; j < N; ++j) {
         T d = S(j, j);
-        for (int k = 0; k < j; ++k) d -= L_(j, k) * L_(j, k);
-        // d = L_jj^2: the pivot criterion of the file comment (NaN fails).
+        for (int k = 0; k < j; ++k) d -= L_(j, k) * LD_(j, k);
+        // The pivot criterion of the file comment (NaN fails).
         if (!(d > tol * S(j, j))) return false;
-        const T ljj = std::sqrt(d);
-        L_(j, j) = ljj;
-        inv_diag_(j) = T(1) / ljj;
+        inv_diag_(j) = T(1) / d;
         for (int i = j + 1; i < N; ++i) {
           T v = S(i, j);
-          for (int k = 0; k < j; ++k) v -= L_(i, k) * L_(j, k);
+          for (int k = 0; k < j; ++k) v -= L_(i, k) * LD_(j, k);
+          LD_(i, j) = v;                    // L_ij d_j
           L_(i, j) = v * inv_diag_(j);
         }
       }
       return true;
     }
   }
-  /// \f$ r^\top S^{-1} r = \|L^{-1} r\|^2 \f$.
+  /// \f$ r^\top S^{-1} r = \sum_j y_j^2 / d_j,\; y = L^{-1} r \f$.
   [[nodiscard, gnu::always_inline]] T nis(const Vec& r) const {
     if constexpr (N <= 2) {
       return r.dot(inv_ * r);
@@ -187,8 +187,8 @@ class SpdSolver {
       for (int j = 0; j < N; ++j) {
         T v = r(j);
         for (int k = 0; k < j; ++k) v -= L_(j, k) * y(k);
-        y(j) = v * inv_diag_(j);
-        sum += y(j) * y(j);
+        y(j) = v;
+        sum += v * v * inv_diag_(j);
       }
       return sum;
     }
@@ -200,17 +200,18 @@ class SpdSolver {
     if constexpr (N <= 2) {
       return A * inv_;
     } else {
-      // X S = A  <=>  (X L) L^T = A: Y L^T = A forward, then X L = Y backward.
+      // X S = A  <=>  (X L D) L^T = A: Y L^T = A forward, Y D^-1, then
+      // X L = Y D^-1 backward (L unit lower triangular).
       Eigen::Matrix<T, M, N> X;
       for (int j = 0; j < N; ++j) {
         Eigen::Matrix<T, M, 1> v = A.col(j);
         for (int k = 0; k < j; ++k) v -= L_(j, k) * X.col(k);
-        X.col(j) = v * inv_diag_(j);
+        X.col(j) = v;
       }
       for (int j = N - 1; j >= 0; --j) {
-        Eigen::Matrix<T, M, 1> v = X.col(j);
+        Eigen::Matrix<T, M, 1> v = X.col(j) * inv_diag_(j);
         for (int k = j + 1; k < N; ++k) v -= L_(k, j) * X.col(k);
-        X.col(j) = v * inv_diag_(j);
+        X.col(j) = v;
       }
       return X;
     }
@@ -243,7 +244,8 @@ class SpdSolver {
     }
   }
   [[no_unique_address]] Inverse inv_ = zero_inverse();
-  [[no_unique_address]] Factor L_ = zero_factor();
+  [[no_unique_address]] Factor L_ = zero_factor();   // unit lower triangular L
+  [[no_unique_address]] Factor LD_ = zero_factor();  // L_ij d_j (i > j)
   [[no_unique_address]] InvDiag inv_diag_ = zero_inv_diag();
 };
 
