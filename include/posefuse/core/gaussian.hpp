@@ -206,7 +206,8 @@ template <class Derived>
 /// criterion with margins. True only when the reference (psd_reference) is
 /// certain to accept `m` as definite; false means "undecided".
 ///
-/// Checks: `m` exactly symmetric, every variance in \f$ [2^{-100}, 2^{100}] \f$,
+/// Checks: `m` exactly symmetric, every variance in \f$ [2^{-e}, 2^{e}] \f$
+/// (e = (max_exponent - 24) / 2n: double 125 at n = 4, float 13),
 /// \f$ m_{ij}^2 \le m_{ii} m_{jj} \f$, then the leading principal minors
 /// \f$ D_k \f$ (cofactor / Laplace expansion) against \f$ \theta_k \prod_{i<k}
 /// m_{ii} \f$ with \f$ \theta_k = 12 k\,k!\,\epsilon \f$ for k < n and
@@ -237,7 +238,16 @@ template <class Derived>
   if constexpr (!(theta3 < T(0.5) && theta4 < T(0.5))) {
     return false;
   } else {
-    const T lo = T(0x1p-100), hi = T(0x1p100);
+    // 2^-e and 2^e with e = (max_exponent - 24) / (2N): every product of
+    // up to N entries (and the thresholds) stays a normal number (double:
+    // 2^-125 .. 2^125 at N = 4; float: 2^-13 .. 2^13).
+    constexpr int e = (std::numeric_limits<T>::max_exponent - 24) / (2 * N);
+    constexpr T hi = [] {
+      T v = T(1);
+      for (int i = 0; i < e; ++i) v *= T(2);
+      return v;
+    }();
+    constexpr T lo = T(1) / hi;
     T a[N][N];
     for (int i = 0; i < N; ++i) {
       a[i][i] = m(i, i);
