@@ -1,207 +1,651 @@
-// Per-step cost of seed 000's EKF (predict + update, G = H = I, 2-D state).
+// Per-step cost of posefuse::Ekf against the textbook EKF step, workload by
+// workload, all in this one binary.
 //
 //   cmake --preset release && cmake --build --preset release --target bench_filters
-//   ./build-release/benchmarks/bench_filters
+//   ./build-release/benchmarks/bench_filters --benchmark_repetitions=5 \
+//       --benchmark_report_aggregates_only=true --benchmark_enable_random_interleaving=true
 //
-// Side by side in this binary:
-//   BM_Seed000Ekf_Step/posefuse      posefuse::Ekf (fixed-size, Joseph form, LLT,
-//                                    identity Jacobians skipped at compile time)
-//   BM_Seed000Ekf_Step/posefuse_recompute
-//                                    the same filter through update_with(), which
-//                                    recomputes the gain every step (what any
-//                                    filter whose covariance has not converged,
-//                                    or whose noise varies, pays)
-//   BM_Seed000Ekf_Step/naive_fixed   the textbook step written directly with
-//                                    fixed-size Eigen (G, H multiplied, S inverted)
-//   BM_Seed000Ekf_Step/dynamic       the same textbook step with Eigen::MatrixXd
-//   BM_ConstantVelocityEkf_Step      4-D constant-velocity predict + 2-D fix
-// The cost of the PSD checks inside those steps (core/gaussian.hpp's
-// criterion; Ekf checks the predicted covariance every predict and the
-// posterior whenever the gain is recomputed), without a knob on Ekf:
-//   .../<step>_plus_check            the same step plus one more
-//                                    is_positive_semidefinite() of the filter's
-//                                    covariance, as the step itself does it:
-//                                    the difference to <step> is the marginal
-//                                    cost of one check inside the step
-//   BM_PsdCheck/<n>                  is_positive_semidefinite() alone on the
-//                                    covariances those filters produce
-//   BM_PsdCheck_Reference/<n>        the same on the completely pivoted LDLT
-//                                    alone (detail::psd_reference), i.e. without
-//                                    the fast path
-// Inputs are generated once outside the timed loop; each iteration runs one
-// frame of a 1024-frame sequence.
+// Every workload BM_<Workload> has three implementations of one EKF step
+// (predict + update) on the same inputs:
+//   BM_<Workload>/posefuse      posefuse::Ekf with the default options
+//                               (EkfOptions: Joseph form, NIS always, Jacobian
+//                               recorded, gain memo on) and the library's models
+//   BM_<Workload>/naive_fixed   the textbook step written directly with
+//                               fixed-size Eigen: Pbar = F P F^T + Q,
+//                               K = Pbar H^T (H Pbar H^T + R)^-1,
+//                               x = xbar + K (z - h(xbar)), P = (I - K H) Pbar
+//   BM_<Workload>/dynamic       the same textbook step with Eigen::MatrixXd
+// and, where posefuse's steady-state gain memo can hit, a fourth row without it:
+//   BM_<Workload>/posefuse_nomemo   BasicEkf with EkfOptions::kGainMemo = false
+//   BM_Seed000Ekf_Step/posefuse_recompute   update_with() a sensor held outside the
+//                               filter (never memoised), as README has quoted it
+// Before timing, each benchmark runs every implementation of its workload for
+// 256 frames from the same start and stops with an error (SkipWithError)
+// unless all states agree to 1e-9 (relative); so a faster row cannot be
+// computing something else.
+//
+// Workloads (1024 frames generated once, cycled; one frame per iteration):
+//   Seed000Ekf            seed 000: x' = x + u, H = I (2-D), constant noise
+//   Seed000Kitti          the same with process noise R * dt / 0.1 s, dt the real
+//                         frame intervals of KITTI 06 (times.txt, see kitti_intervals())
+//   ConstantVelocityEkf   4-D constant velocity, 2-D position fix, dt = 0.1 s
+//   ConstantVelocityKitti the same at the KITTI 06 frame intervals
+//   UnicyclePoseFix       3-D unicycle (exact arc, control noise), full pose fix
+//                         with the heading residual wrapped
+//   Pose15                15-state 3-D kinematics (position, roll-pitch-yaw,
+//                         their rates, linear acceleration; world frame, angles
+//                         unwrapped) with a 6-D pose measurement
+// Also:
+//   BM_PsdCheck/<n>            is_positive_semidefinite() alone on covariances
+//                              those filters produce (n = 2, 4, 15)
+//   BM_PsdCheck_Reference/<n>  the same on the completely pivoted LDLT alone
 #include <Eigen/Dense>
 #include <benchmark/benchmark.h>
+#include <posefuse/core/angles.hpp>
 #include <posefuse/filters/ekf.hpp>
 #include <posefuse/models/constant_velocity.hpp>
 #include <posefuse/models/planar_displacement.hpp>
+#include <posefuse/models/planar_pose_fix.hpp>
 #include <posefuse/models/position.hpp>
+#include <posefuse/models/unicycle.hpp>
 #include <array>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
 #include <random>
+#include <string>
 #include <vector>
 
 namespace {
 
-struct Frames {
+constexpr std::size_t kFrames = 1024;
+constexpr int kCheckFrames = 256;
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+// ---------------------------------------------------------------------------
+// Inputs
+
+/// Frame intervals of KITTI 06: $POSEFUSE_DATA_DIR/kitti/06/times.txt, else
+/// ../shared/data/kitti/06/times.txt (relative to the working directory).
+/// When neither exists, a generated equivalent: 1100 intervals uniform in
+/// [0.10324, 0.10466] s (the real file's range; its mean is 0.10390 s, its
+/// standard deviation 0.15 ms). Cycled to kFrames.
+struct Intervals {
+  std::vector<double> dt;
+  bool real = false;
+};
+const Intervals& kitti_intervals() {
+  static const Intervals out = [] {
+    Intervals iv;
+    std::vector<std::string> paths;
+    if (const char* d = std::getenv("POSEFUSE_DATA_DIR")) paths.push_back(std::string(d) + "/kitti/06/times.txt");
+    paths.emplace_back("../shared/data/kitti/06/times.txt");
+    for (const std::string& p : paths) {
+      std::ifstream in(p);
+      std::vector<double> t;
+      double v = 0;
+      while (in >> v) t.push_back(v);
+      if (t.size() > 2) {
+        for (std::size_t i = 1; i < t.size(); ++i) iv.dt.push_back(t[i] - t[i - 1]);
+        iv.real = true;
+        break;
+      }
+    }
+    if (!iv.real) {
+      std::mt19937 rng(6);
+      std::uniform_real_distribution<double> u(0.10324, 0.10466);
+      for (int i = 0; i < 1100; ++i) iv.dt.push_back(u(rng));
+    }
+    std::vector<double> cycled;
+    for (std::size_t k = 0; k < kFrames; ++k) cycled.push_back(iv.dt[k % iv.dt.size()]);
+    iv.dt = cycled;
+    return iv;
+  }();
+  return out;
+}
+
+struct PlanarFrames {
   std::vector<Eigen::Vector2d> u, z;
 };
-
-const Frames& frames() {
-  static const Frames f = [] {
-    Frames out;
+const PlanarFrames& planar_frames() {  // seed 000's inputs (as before this file's rewrite)
+  static const PlanarFrames f = [] {
+    PlanarFrames out;
     std::mt19937 rng(3);
     std::normal_distribution<double> n(0.0, 0.3);
     Eigen::Vector2d p(0, 0);
-    for (int k = 0; k < 1024; ++k) {
-      const Eigen::Vector2d step(1.0 + n(rng), 0.2 * n(rng));
+    for (std::size_t k = 0; k < kFrames; ++k) {
+      const double sx = n(rng);
+      const double sy = n(rng);
+      const Eigen::Vector2d step(1.0 + sx, 0.2 * sy);
       p += step;
       out.u.push_back(step);
-      out.z.push_back(p + Eigen::Vector2d(n(rng), n(rng)));
+      const double zx = n(rng);
+      const double zy = n(rng);
+      out.z.push_back(p + Eigen::Vector2d(zx, zy));
     }
     return out;
   }();
   return f;
 }
 
-// One posefuse seed-000 step; kRecompute: update_with() a sensor built once
-// outside the loop, so the gain memo of update<0> is never used; kExtraCheck:
-// one more is_positive_semidefinite of the predicted covariance per step
-// (the `_plus_check` rows: the cost of one check in context).
-template <bool kRecompute, bool kExtraCheck>
-void BM_Seed000Ekf_Step_posefuse_variant(benchmark::State& state) {
-  const Frames& f = frames();
-  const posefuse::PositionFix<2> fix = posefuse::PositionFix<2>::isotropic(0.5);
-  posefuse::Ekf<posefuse::PlanarDisplacement<double>, posefuse::PositionFix<2>> ekf(
-      posefuse::PlanarDisplacement<double>::from_sigmas(0.1, 0.1), fix);
-  ekf.reset(f.z[0], Eigen::Matrix2d::Identity());
+template <class A, class B>
+double rel_error(const A& a, const B& b) {
+  return (a - b).cwiseAbs().maxCoeff() / (1.0 + b.cwiseAbs().maxCoeff());
+}
+
+// ---------------------------------------------------------------------------
+// The harness: agreement check, then the timed loop.
+
+/// Runs every implementation of workload W for kCheckFrames frames and
+/// compares their states with W::Naive's. @return empty, or what disagreed
+template <class W>
+std::string disagreement() {
+  typename W::Naive ref;
+  typename W::Posefuse a;
+  typename W::Dynamic b;
+  typename W::PosefuseNoMemo c;
+  for (int k = 0; k < kCheckFrames; ++k) {
+    (void)ref.step(std::size_t(k));
+    (void)a.step(std::size_t(k));
+    (void)b.step(std::size_t(k));
+    (void)c.step(std::size_t(k));
+  }
+  const VectorXd x = ref.state();
+  if (!x.allFinite()) return "reference state not finite";
+  if (!(W::difference(a.state(), x) <= 1e-9)) return "posefuse state differs from naive_fixed";
+  if (!(W::difference(b.state(), x) <= 1e-9)) return "dynamic state differs from naive_fixed";
+  if (!(W::difference(c.state(), x) <= 1e-9)) return "posefuse_nomemo state differs from naive_fixed";
+  return {};
+}
+
+template <class W, class Impl>
+void BM_Step(benchmark::State& st) {
+  static const std::string why = disagreement<W>();
+  if (!why.empty()) {
+    st.SkipWithError(why.c_str());
+    return;
+  }
+  Impl impl;
   std::size_t k = 0;
-  for (auto _ : state) {
-    benchmark::DoNotOptimize(ekf.predict(f.u[k], 1.0));
-    if constexpr (kExtraCheck)
-      benchmark::DoNotOptimize(posefuse::is_positive_semidefinite(ekf.covariance()));
-    if constexpr (kRecompute) {
-      auto r = ekf.update_with(fix, f.z[k]);
-      benchmark::DoNotOptimize(r);
+  for (auto _ : st) {
+    benchmark::DoNotOptimize(impl.step(k));
+    k = (k + 1) & (kFrames - 1);
+  }
+  benchmark::DoNotOptimize(impl.state());
+}
+
+struct NoMemo : posefuse::EkfOptions {
+  static constexpr bool kGainMemo = false;
+};
+
+/// Euclidean states: relative max difference.
+struct Euclidean {
+  static double difference(const VectorXd& a, const VectorXd& b) { return rel_error(a, b); }
+};
+
+// ---------------------------------------------------------------------------
+// Seed 000 (constant noise) and seed 000 at KITTI intervals
+
+/// Seed 000's motion with process noise scaled by the frame interval.
+struct ScaledDisplacement {
+  using State = Eigen::Vector2d;
+  using Control = Eigen::Vector2d;
+  static constexpr bool kIdentityJacobian = true;
+  Eigen::Matrix2d R = Eigen::Matrix2d::Identity() * 0.01;  // per 0.1 s
+  State predict(const State& x, const Control& u, double) const { return x + u; }
+  Eigen::Matrix2d jacobian(const State&, const Control&, double) const {
+    return Eigen::Matrix2d::Identity();
+  }
+  Eigen::Matrix2d noise(const State&, const Control&, double dt) const { return R * (dt / 0.1); }
+};
+
+template <bool kKitti>
+struct Seed000 : Euclidean {
+  static double dt(std::size_t k) { return kKitti ? kitti_intervals().dt[k] : 1.0; }
+  static double scale(std::size_t k) { return kKitti ? dt(k) / 0.1 : 1.0; }
+  using Motion = std::conditional_t<kKitti, ScaledDisplacement, posefuse::PlanarDisplacement<double>>;
+  static Motion motion() {
+    if constexpr (kKitti) {
+      return ScaledDisplacement{};
     } else {
-      auto r = ekf.update<0>(f.z[k]);
-      benchmark::DoNotOptimize(r);
+      return posefuse::PlanarDisplacement<double>::from_sigmas(0.1, 0.1);
     }
-    k = (k + 1) & 1023;
   }
-  benchmark::DoNotOptimize(ekf.state());
-}
-BENCHMARK_TEMPLATE(BM_Seed000Ekf_Step_posefuse_variant, false, false)
-    ->Name("BM_Seed000Ekf_Step/posefuse");
-BENCHMARK_TEMPLATE(BM_Seed000Ekf_Step_posefuse_variant, false, true)
-    ->Name("BM_Seed000Ekf_Step/posefuse_plus_check");
-BENCHMARK_TEMPLATE(BM_Seed000Ekf_Step_posefuse_variant, true, false)
-    ->Name("BM_Seed000Ekf_Step/posefuse_recompute");
-BENCHMARK_TEMPLATE(BM_Seed000Ekf_Step_posefuse_variant, true, true)
-    ->Name("BM_Seed000Ekf_Step/posefuse_recompute_plus_check");
+  template <class Options>
+  struct Filter {
+    posefuse::BasicEkf<Options, Motion, posefuse::PositionFix<2>> ekf{
+        motion(), posefuse::PositionFix<2>::isotropic(0.5)};
+    Filter() { ekf.reset(planar_frames().z[0], Eigen::Matrix2d::Identity()); }
+    posefuse::FilterStatus step(std::size_t k) {
+      const PlanarFrames& f = planar_frames();
+      (void)ekf.predict(f.u[k], dt(k));
+      return ekf.template update<0>(f.z[k]).status;
+    }
+    VectorXd state() const { return ekf.state(); }
+  };
+  using Posefuse = Filter<posefuse::EkfOptions>;
+  using PosefuseNoMemo = Filter<NoMemo>;
+  struct Naive {
+    Eigen::Vector2d mu = planar_frames().z[0];
+    Eigen::Matrix2d S = Eigen::Matrix2d::Identity();
+    double step(std::size_t k) {
+      const PlanarFrames& f = planar_frames();
+      const Eigen::Matrix2d G = Eigen::Matrix2d::Identity();
+      const Eigen::Matrix2d H = Eigen::Matrix2d::Identity();
+      const Eigen::Matrix2d R = Eigen::Matrix2d::Identity() * (0.01 * scale(k));
+      const Eigen::Matrix2d Q = Eigen::Matrix2d::Identity() * 0.25;
+      const Eigen::Vector2d mubar = mu + f.u[k];
+      const Eigen::Matrix2d Sbar = G * S * G.transpose() + R;
+      const Eigen::Matrix2d K = Sbar * H.transpose() * (H * Sbar * H.transpose() + Q).inverse();
+      mu = mubar + K * (f.z[k] - H * mubar);
+      S = (Eigen::Matrix2d::Identity() - K * H) * Sbar;
+      return S(0, 0);
+    }
+    VectorXd state() const { return mu; }
+  };
+  struct Dynamic {
+    VectorXd mu = planar_frames().z[0];
+    MatrixXd S = MatrixXd::Identity(2, 2);
+    double step(std::size_t k) {
+      const PlanarFrames& f = planar_frames();
+      const MatrixXd G = MatrixXd::Identity(2, 2);
+      const MatrixXd H = MatrixXd::Identity(2, 2);
+      const MatrixXd I = MatrixXd::Identity(2, 2);
+      const MatrixXd R = MatrixXd::Identity(2, 2) * (0.01 * scale(k));
+      const MatrixXd Q = MatrixXd::Identity(2, 2) * 0.25;
+      const VectorXd u = f.u[k];
+      const VectorXd z = f.z[k];
+      const VectorXd mubar = mu + u;
+      const MatrixXd Sbar = G * S * G.transpose() + R;
+      const MatrixXd Sinn = H * Sbar * H.transpose() + Q;
+      const MatrixXd K = Sbar * H.transpose() * Sinn.inverse();
+      mu = mubar + K * (z - H * mubar);
+      S = (I - K * H) * Sbar;
+      return S(0, 0);
+    }
+    VectorXd state() const { return mu; }
+  };
+};
 
-void BM_Seed000Ekf_Step_naive_fixed(benchmark::State& state) {
-  const Frames& f = frames();
-  const Eigen::Matrix2d G = Eigen::Matrix2d::Identity();
-  const Eigen::Matrix2d H = Eigen::Matrix2d::Identity();
-  const Eigen::Matrix2d R = Eigen::Matrix2d::Identity() * 0.01;
-  const Eigen::Matrix2d Q = Eigen::Matrix2d::Identity() * 0.25;
-  Eigen::Vector2d mu = f.z[0];
-  Eigen::Matrix2d S = Eigen::Matrix2d::Identity();
-  std::size_t k = 0;
-  for (auto _ : state) {
-    const Eigen::Vector2d mubar = mu + f.u[k];
-    const Eigen::Matrix2d Sbar = G * S * G.transpose() + R;
-    const Eigen::Matrix2d K = Sbar * H.transpose() * (H * Sbar * H.transpose() + Q).inverse();
-    mu = mubar + K * (f.z[k] - H * mubar);
-    S = (Eigen::Matrix2d::Identity() - K * H) * Sbar;
-    benchmark::DoNotOptimize(mu);
-    benchmark::DoNotOptimize(S);
-    k = (k + 1) & 1023;
+/// update_with() a sensor held outside the filter: the gain is recomputed
+/// every step (README's posefuse_recompute row).
+struct Seed000Recompute {
+  posefuse::PositionFix<2> fix = posefuse::PositionFix<2>::isotropic(0.5);
+  posefuse::Ekf<posefuse::PlanarDisplacement<double>, posefuse::PositionFix<2>> ekf{
+      posefuse::PlanarDisplacement<double>::from_sigmas(0.1, 0.1), fix};
+  Seed000Recompute() { ekf.reset(planar_frames().z[0], Eigen::Matrix2d::Identity()); }
+  posefuse::FilterStatus step(std::size_t k) {
+    const PlanarFrames& f = planar_frames();
+    (void)ekf.predict(f.u[k], 1.0);
+    return ekf.update_with(fix, f.z[k]).status;
   }
-}
-BENCHMARK(BM_Seed000Ekf_Step_naive_fixed)->Name("BM_Seed000Ekf_Step/naive_fixed");
+  VectorXd state() const { return ekf.state(); }
+};
 
-void BM_Seed000Ekf_Step_dynamic(benchmark::State& state) {
-  const Frames& f = frames();
-  const Eigen::MatrixXd G = Eigen::MatrixXd::Identity(2, 2);
-  const Eigen::MatrixXd H = Eigen::MatrixXd::Identity(2, 2);
-  const Eigen::MatrixXd I = Eigen::MatrixXd::Identity(2, 2);
-  const Eigen::MatrixXd R = Eigen::MatrixXd::Identity(2, 2) * 0.01;
-  const Eigen::MatrixXd Q = Eigen::MatrixXd::Identity(2, 2) * 0.25;
-  Eigen::VectorXd mu = f.z[0];
-  Eigen::MatrixXd S = Eigen::MatrixXd::Identity(2, 2);
-  std::size_t k = 0;
-  for (auto _ : state) {
-    const Eigen::VectorXd u = f.u[k];
-    const Eigen::VectorXd z = f.z[k];
-    const Eigen::VectorXd mubar = mu + u;
-    const Eigen::MatrixXd Sbar = G * S * G.transpose() + R;
-    const Eigen::MatrixXd Sinn = H * Sbar * H.transpose() + Q;
-    const Eigen::MatrixXd K = Sbar * H.transpose() * Sinn.inverse();
-    mu = mubar + K * (z - H * mubar);
-    S = (I - K * H) * Sbar;
-    benchmark::DoNotOptimize(mu.data());
-    benchmark::DoNotOptimize(S.data());
-    k = (k + 1) & 1023;
-  }
-}
-BENCHMARK(BM_Seed000Ekf_Step_dynamic)->Name("BM_Seed000Ekf_Step/dynamic");
+// ---------------------------------------------------------------------------
+// Constant velocity (dt = 0.1 s, and KITTI intervals)
 
-// The constant-velocity step; kExtraCheck as above.
-template <bool kExtraCheck>
-void BM_ConstantVelocityEkf_Step_variant(benchmark::State& state) {
-  const Frames& f = frames();
-  posefuse::Ekf<posefuse::ConstantVelocity2<double>, posefuse::PositionFix<4>> ekf(
-      posefuse::ConstantVelocity2<double>(1.0), posefuse::PositionFix<4>::isotropic(0.5));
-  Eigen::Vector4d x0;
-  x0 << f.z[0], 0, 0;
-  ekf.reset(x0, Eigen::Matrix4d::Identity());
-  std::size_t k = 0;
-  for (auto _ : state) {
-    benchmark::DoNotOptimize(ekf.predict(posefuse::NoControl{}, 0.1));
-    if constexpr (kExtraCheck)
-      benchmark::DoNotOptimize(posefuse::is_positive_semidefinite(ekf.covariance()));
-    auto r = ekf.update<0>(f.z[k]);
-    benchmark::DoNotOptimize(r);
-    k = (k + 1) & 1023;
+template <bool kKitti>
+struct ConstantVelocity : Euclidean {
+  static constexpr double kQ = 1.0, kSigma = 0.5;
+  static double dt(std::size_t k) { return kKitti ? kitti_intervals().dt[k] : 0.1; }
+  static Eigen::Vector4d x0() {
+    Eigen::Vector4d x;
+    x << planar_frames().z[0], 0, 0;
+    return x;
   }
+  static Eigen::Vector2d z(std::size_t k) { return planar_frames().z[k] * 0.1; }
+  template <class Options>
+  struct Filter {
+    posefuse::BasicEkf<Options, posefuse::ConstantVelocity2<double>, posefuse::PositionFix<4>> ekf{
+        posefuse::ConstantVelocity2<double>(kQ), posefuse::PositionFix<4>::isotropic(kSigma)};
+    Filter() { ekf.reset(x0(), Eigen::Matrix4d::Identity()); }
+    posefuse::FilterStatus step(std::size_t k) {
+      (void)ekf.predict(posefuse::NoControl{}, dt(k));
+      return ekf.template update<0>(z(k)).status;
+    }
+    VectorXd state() const { return ekf.state(); }
+  };
+  using Posefuse = Filter<posefuse::EkfOptions>;
+  using PosefuseNoMemo = Filter<NoMemo>;
+  struct Naive {
+    Eigen::Vector4d mu = x0();
+    Eigen::Matrix4d S = Eigen::Matrix4d::Identity();
+    double step(std::size_t k) {
+      const double t = dt(k);
+      Eigen::Matrix4d F = Eigen::Matrix4d::Identity();
+      F(0, 2) = F(1, 3) = t;
+      Eigen::Matrix4d Q = Eigen::Matrix4d::Zero();
+      Q(0, 0) = Q(1, 1) = kQ * t * t * t / 3;
+      Q(0, 2) = Q(2, 0) = Q(1, 3) = Q(3, 1) = kQ * t * t / 2;
+      Q(2, 2) = Q(3, 3) = kQ * t;
+      Eigen::Matrix<double, 2, 4> H = Eigen::Matrix<double, 2, 4>::Zero();
+      H(0, 0) = H(1, 1) = 1;
+      const Eigen::Matrix2d R = Eigen::Matrix2d::Identity() * (kSigma * kSigma);
+      const Eigen::Vector4d mubar = F * mu;
+      const Eigen::Matrix4d Sbar = F * S * F.transpose() + Q;
+      const Eigen::Matrix<double, 4, 2> K =
+          Sbar * H.transpose() * (H * Sbar * H.transpose() + R).inverse();
+      mu = mubar + K * (z(k) - H * mubar);
+      S = (Eigen::Matrix4d::Identity() - K * H) * Sbar;
+      return S(0, 0);
+    }
+    VectorXd state() const { return mu; }
+  };
+  struct Dynamic {
+    VectorXd mu = x0();
+    MatrixXd S = MatrixXd::Identity(4, 4);
+    double step(std::size_t k) {
+      const double t = dt(k);
+      MatrixXd F = MatrixXd::Identity(4, 4);
+      F(0, 2) = F(1, 3) = t;
+      MatrixXd Q = MatrixXd::Zero(4, 4);
+      Q(0, 0) = Q(1, 1) = kQ * t * t * t / 3;
+      Q(0, 2) = Q(2, 0) = Q(1, 3) = Q(3, 1) = kQ * t * t / 2;
+      Q(2, 2) = Q(3, 3) = kQ * t;
+      MatrixXd H = MatrixXd::Zero(2, 4);
+      H(0, 0) = H(1, 1) = 1;
+      const MatrixXd R = MatrixXd::Identity(2, 2) * (kSigma * kSigma);
+      const VectorXd zk = z(k);
+      const VectorXd mubar = F * mu;
+      const MatrixXd Sbar = F * S * F.transpose() + Q;
+      const MatrixXd Sinn = H * Sbar * H.transpose() + R;
+      const MatrixXd K = Sbar * H.transpose() * Sinn.inverse();
+      mu = mubar + K * (zk - H * mubar);
+      S = (MatrixXd::Identity(4, 4) - K * H) * Sbar;
+      return S(0, 0);
+    }
+    VectorXd state() const { return mu; }
+  };
+};
+
+// ---------------------------------------------------------------------------
+// Unicycle + pose fix
+
+struct UnicyclePoseFix {
+  struct Inputs {
+    std::vector<Eigen::Vector2d> u;
+    std::vector<posefuse::PlanarPose<double>> z;
+  };
+  static const Inputs& inputs() {
+    static const Inputs in = [] {
+      Inputs out;
+      std::mt19937 rng(7);
+      std::normal_distribution<double> n(0.0, 1.0);
+      posefuse::PlanarPose<double> p{};
+      for (std::size_t k = 0; k < kFrames; ++k) {
+        const double v = 1.0 + 0.1 * n(rng);
+        const double w = 0.3 * std::sin(double(k) / 50.0) + 0.05 * n(rng);
+        out.u.emplace_back(v, w);
+        p = posefuse::unicycle_step(p, v * 0.1, w * 0.1, posefuse::Integration::kExactArc);
+        const double ex = 0.2 * n(rng);
+        const double ey = 0.2 * n(rng);
+        const double et = 0.05 * n(rng);
+        out.z.push_back({p.x + ex, p.y + ey, posefuse::wrap_angle(p.theta + et)});
+      }
+      return out;
+    }();
+    return in;
+  }
+  static constexpr double kDt = 0.1;
+  static Eigen::Matrix2d control_cov() { return Eigen::Vector2d(0.05 * 0.05, 0.02 * 0.02).asDiagonal(); }
+  static Eigen::Matrix3d pose_cov() { return Eigen::Vector3d(0.04, 0.04, 0.0025).asDiagonal(); }
+  static double difference(const VectorXd& a, const VectorXd& b) {
+    VectorXd d = a - b;
+    d(2) = posefuse::angle_diff(a(2), b(2));
+    return d.cwiseAbs().maxCoeff() / (1.0 + b.cwiseAbs().maxCoeff());
+  }
+  static posefuse::Unicycle<double> motion() {
+    posefuse::Unicycle<double> m;
+    m.method = posefuse::Integration::kExactArc;
+    m.control_cov = control_cov();
+    return m;
+  }
+  template <class Options>
+  struct Filter {
+    posefuse::BasicEkf<Options, posefuse::Unicycle<double>, posefuse::PlanarPoseFix<double>> ekf{
+        motion(), posefuse::PlanarPoseFix<double>(pose_cov())};
+    Filter() { ekf.reset(posefuse::PlanarPose<double>{}, Eigen::Matrix3d::Identity() * 0.1); }
+    posefuse::FilterStatus step(std::size_t k) {
+      (void)ekf.predict(inputs().u[k], kDt);
+      return ekf.template update<0>(inputs().z[k]).status;
+    }
+    VectorXd state() const { return ekf.state().vector(); }
+  };
+  using Posefuse = Filter<posefuse::EkfOptions>;
+  using PosefuseNoMemo = Filter<NoMemo>;
+  struct Naive {
+    Eigen::Vector3d mu = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d S = Eigen::Matrix3d::Identity() * 0.1;
+    double step(std::size_t k) {
+      const Eigen::Vector2d& u = inputs().u[k];
+      Eigen::Matrix3d G;
+      Eigen::Matrix<double, 3, 2> V;
+      const posefuse::PlanarPose<double> pbar = posefuse::unicycle_step(
+          posefuse::PlanarPose<double>{mu(0), mu(1), mu(2)}, u(0) * kDt, u(1) * kDt,
+          posefuse::Integration::kExactArc, &G, &V);
+      const Eigen::Vector3d mubar = pbar.vector();
+      const Eigen::Matrix3d H = Eigen::Matrix3d::Identity();
+      const Eigen::Matrix3d Sbar = G * S * G.transpose() + (kDt * kDt) * (V * control_cov() * V.transpose());
+      const Eigen::Matrix3d K = Sbar * H.transpose() * (H * Sbar * H.transpose() + pose_cov()).inverse();
+      const posefuse::PlanarPose<double>& z = inputs().z[k];
+      Eigen::Vector3d r = z.vector() - H * mubar;
+      r(2) = posefuse::angle_diff(z.theta, mubar(2));
+      mu = mubar + K * r;
+      mu(2) = posefuse::wrap_angle(mu(2));
+      S = (Eigen::Matrix3d::Identity() - K * H) * Sbar;
+      return S(0, 0);
+    }
+    VectorXd state() const { return mu; }
+  };
+  struct Dynamic {
+    VectorXd mu = VectorXd::Zero(3);
+    MatrixXd S = MatrixXd::Identity(3, 3) * 0.1;
+    double step(std::size_t k) {
+      const Eigen::Vector2d& u = inputs().u[k];
+      Eigen::Matrix3d Gf;
+      Eigen::Matrix<double, 3, 2> Vf;
+      const posefuse::PlanarPose<double> pbar = posefuse::unicycle_step(
+          posefuse::PlanarPose<double>{mu(0), mu(1), mu(2)}, u(0) * kDt, u(1) * kDt,
+          posefuse::Integration::kExactArc, &Gf, &Vf);
+      const MatrixXd G = Gf, V = Vf, M = control_cov() * (kDt * kDt), Q = pose_cov();
+      const MatrixXd H = MatrixXd::Identity(3, 3);
+      const VectorXd mubar = pbar.vector();
+      const MatrixXd Sbar = G * S * G.transpose() + V * M * V.transpose();
+      const MatrixXd Sinn = H * Sbar * H.transpose() + Q;
+      const MatrixXd K = Sbar * H.transpose() * Sinn.inverse();
+      const posefuse::PlanarPose<double>& z = inputs().z[k];
+      VectorXd r = z.vector() - H * mubar;
+      r(2) = posefuse::angle_diff(z.theta, mubar(2));
+      mu = mubar + K * r;
+      mu(2) = posefuse::wrap_angle(mu(2));
+      S = (MatrixXd::Identity(3, 3) - K * H) * Sbar;
+      return S(0, 0);
+    }
+    VectorXd state() const { return mu; }
+  };
+};
+
+// ---------------------------------------------------------------------------
+// 15-state 3-D kinematics with a 6-D pose measurement
+
+/// x = [p (3), rpy (3), v (3), rpy rates (3), a (3)] in the world frame:
+/// p' = p + v dt + a dt^2 / 2, rpy' = rpy + w dt, v' = v + a dt; white noise
+/// q dt on every component. The angles are treated as a vector (unwrapped;
+/// a benchmark of the linear algebra, not an attitude filter).
+struct Kinematic15 {
+  using State = Eigen::Matrix<double, 15, 1>;
+  using Control = posefuse::NoControl;
+  using Matrix = Eigen::Matrix<double, 15, 15>;
+  static Matrix F_of(double dt) {
+    Matrix F = Matrix::Identity();
+    for (int i = 0; i < 3; ++i) {
+      F(i, 6 + i) = dt;
+      F(i, 12 + i) = 0.5 * dt * dt;
+      F(3 + i, 9 + i) = dt;
+      F(6 + i, 12 + i) = dt;
+    }
+    return F;
+  }
+  static Eigen::Matrix<double, 15, 1> q_diag() {
+    Eigen::Matrix<double, 15, 1> q;
+    q << 0.01, 0.01, 0.01, 0.001, 0.001, 0.001, 0.1, 0.1, 0.1, 0.01, 0.01, 0.01, 1.0, 1.0, 1.0;
+    return q;
+  }
+  State predict(const State& x, const Control&, double dt) const {
+    State y = x;
+    y.segment<3>(0) += dt * x.segment<3>(6) + (0.5 * dt * dt) * x.segment<3>(12);
+    y.segment<3>(3) += dt * x.segment<3>(9);
+    y.segment<3>(6) += dt * x.segment<3>(12);
+    return y;
+  }
+  Matrix jacobian(const State&, const Control&, double dt) const { return F_of(dt); }
+  Matrix noise(const State&, const Control&, double dt) const {
+    return Matrix(q_diag().asDiagonal()) * dt;
+  }
+  /// F P F^T by row, then column, operations (rows 0-8 read rows 6-14 of P
+  /// before they change: position and angle rows first, velocity rows last).
+  Matrix propagate(const Matrix& P, const State&, const Control&, double dt) const {
+    const double h = 0.5 * dt * dt;
+    Matrix B = P;
+    B.middleRows<3>(0) += dt * P.middleRows<3>(6) + h * P.middleRows<3>(12);
+    B.middleRows<3>(3) += dt * P.middleRows<3>(9);
+    B.middleRows<3>(6) += dt * P.middleRows<3>(12);
+    Matrix out = B;
+    out.middleCols<3>(0) += dt * B.middleCols<3>(6) + h * B.middleCols<3>(12);
+    out.middleCols<3>(3) += dt * B.middleCols<3>(9);
+    out.middleCols<3>(6) += dt * B.middleCols<3>(12);
+    return out;
+  }
+};
+static_assert(posefuse::HasPropagate<Kinematic15>);
+
+struct Pose15 : Euclidean {
+  static constexpr double kDt = 0.1;
+  using Z = Eigen::Matrix<double, 6, 1>;
+  static const std::vector<Z>& measurements() {
+    static const std::vector<Z> zs = [] {
+      std::vector<Z> out;
+      std::mt19937 rng(8);
+      std::normal_distribution<double> n(0.0, 1.0);
+      for (std::size_t k = 0; k < kFrames; ++k) {
+        const double t = double(k) * kDt;
+        Z z;
+        z << 2 * std::sin(0.1 * t), 3 * std::cos(0.07 * t), 0.1 * t, 0.1 * std::sin(0.2 * t),
+            0.05 * std::cos(0.3 * t), 0.2 * t;
+        for (int i = 0; i < 6; ++i) {
+          const double e = n(rng);
+          z(i) += (i < 3 ? 0.1 : 0.01) * e;
+        }
+        out.push_back(z);
+      }
+      return out;
+    }();
+    return zs;
+  }
+  static Eigen::Matrix<double, 6, 6> R() {
+    Eigen::Matrix<double, 6, 1> r;
+    r << 0.01, 0.01, 0.01, 0.0001, 0.0001, 0.0001;
+    return r.asDiagonal();
+  }
+  static Eigen::Matrix<double, 15, 15> P0() { return Eigen::Matrix<double, 15, 15>::Identity(); }
+  using Fix = posefuse::PositionFix<15, 6>;
+  template <class Options>
+  struct Filter {
+    posefuse::BasicEkf<Options, Kinematic15, Fix> ekf{Kinematic15{}, Fix(R())};
+    Filter() { ekf.reset(Kinematic15::State::Zero(), P0()); }
+    posefuse::FilterStatus step(std::size_t k) {
+      (void)ekf.predict(posefuse::NoControl{}, kDt);
+      return ekf.template update<0>(measurements()[k]).status;
+    }
+    VectorXd state() const { return ekf.state(); }
+  };
+  using Posefuse = Filter<posefuse::EkfOptions>;
+  using PosefuseNoMemo = Filter<NoMemo>;
+  struct Naive {
+    using M15 = Eigen::Matrix<double, 15, 15>;
+    Eigen::Matrix<double, 15, 1> mu = Eigen::Matrix<double, 15, 1>::Zero();
+    M15 S = P0();
+    double step(std::size_t k) {
+      const M15 F = Kinematic15::F_of(kDt);
+      const M15 Q = M15(Kinematic15::q_diag().asDiagonal()) * kDt;
+      Eigen::Matrix<double, 6, 15> H = Eigen::Matrix<double, 6, 15>::Zero();
+      H.leftCols<6>().setIdentity();
+      const Eigen::Matrix<double, 15, 1> mubar = F * mu;
+      const M15 Sbar = F * S * F.transpose() + Q;
+      const Eigen::Matrix<double, 15, 6> K =
+          Sbar * H.transpose() * (H * Sbar * H.transpose() + R()).inverse();
+      mu = mubar + K * (measurements()[k] - H * mubar);
+      S = (M15::Identity() - K * H) * Sbar;
+      return S(0, 0);
+    }
+    VectorXd state() const { return mu; }
+  };
+  struct Dynamic {
+    VectorXd mu = VectorXd::Zero(15);
+    MatrixXd S = P0();
+    double step(std::size_t k) {
+      const MatrixXd F = Kinematic15::F_of(kDt);
+      const MatrixXd Q = MatrixXd(Kinematic15::q_diag().asDiagonal()) * kDt;
+      MatrixXd H = MatrixXd::Zero(6, 15);
+      H.leftCols(6).setIdentity();
+      const VectorXd z = measurements()[k];
+      const VectorXd mubar = F * mu;
+      const MatrixXd Sbar = F * S * F.transpose() + Q;
+      const MatrixXd Sinn = H * Sbar * H.transpose() + R();
+      const MatrixXd K = Sbar * H.transpose() * Sinn.inverse();
+      mu = mubar + K * (z - H * mubar);
+      S = (MatrixXd::Identity(15, 15) - K * H) * Sbar;
+      return S(0, 0);
+    }
+    VectorXd state() const { return mu; }
+  };
+};
+
+// ---------------------------------------------------------------------------
+// Registration
+
+template <class W>
+void register_workload(const std::string& name, bool nomemo_row) {
+  benchmark::RegisterBenchmark((name + "/posefuse").c_str(), BM_Step<W, typename W::Posefuse>);
+  if (nomemo_row)
+    benchmark::RegisterBenchmark((name + "/posefuse_nomemo").c_str(),
+                                 BM_Step<W, typename W::PosefuseNoMemo>);
+  benchmark::RegisterBenchmark((name + "/naive_fixed").c_str(), BM_Step<W, typename W::Naive>);
+  benchmark::RegisterBenchmark((name + "/dynamic").c_str(), BM_Step<W, typename W::Dynamic>);
 }
-BENCHMARK_TEMPLATE(BM_ConstantVelocityEkf_Step_variant, false)->Name("BM_ConstantVelocityEkf_Step");
-BENCHMARK_TEMPLATE(BM_ConstantVelocityEkf_Step_variant, true)
-    ->Name("BM_ConstantVelocityEkf_Step_plus_check");
 
 // Covariances as the filters above produce them (predicted and posterior,
-// the first 128 steps of each, so they still change), cycled.
+// the first 128 steps, so they still change), cycled.
 template <int N>
 const std::vector<Eigen::Matrix<double, N, N>>& filter_covariances() {
   static const std::vector<Eigen::Matrix<double, N, N>> out = [] {
     std::vector<Eigen::Matrix<double, N, N>> v;
-    const Frames& f = frames();
+    const auto record = [&v](auto& f, auto&& predict, auto&& update) {
+      for (std::size_t k = 0; k < 128; ++k) {
+        predict(k);
+        v.push_back(f.ekf.covariance());
+        update(k);
+        v.push_back(f.ekf.covariance());
+      }
+    };
     if constexpr (N == 2) {
-      const posefuse::PositionFix<2> fix = posefuse::PositionFix<2>::isotropic(0.5);
-      posefuse::Ekf<posefuse::PlanarDisplacement<double>, posefuse::PositionFix<2>> ekf(
-          posefuse::PlanarDisplacement<double>::from_sigmas(0.1, 0.1), fix);
-      ekf.reset(f.z[0], Eigen::Matrix2d::Identity());
-      for (std::size_t k = 0; k < 128; ++k) {
-        (void)ekf.predict(f.u[k], 1.0);
-        v.push_back(ekf.covariance());
-        (void)ekf.update_with(fix, f.z[k]);
-        v.push_back(ekf.covariance());
-      }
+      Seed000<false>::PosefuseNoMemo f;
+      record(
+          f, [&f](std::size_t k) { (void)f.ekf.predict(planar_frames().u[k], 1.0); },
+          [&f](std::size_t k) { (void)f.ekf.template update<0>(planar_frames().z[k]); });
+    } else if constexpr (N == 4) {
+      ConstantVelocity<false>::PosefuseNoMemo f;
+      record(
+          f, [&f](std::size_t) { (void)f.ekf.predict(posefuse::NoControl{}, 0.1); },
+          [&f](std::size_t k) { (void)f.ekf.template update<0>(ConstantVelocity<false>::z(k)); });
     } else {
-      static_assert(N == 4);
-      const posefuse::PositionFix<4> fix = posefuse::PositionFix<4>::isotropic(0.5);
-      posefuse::Ekf<posefuse::ConstantVelocity2<double>, posefuse::PositionFix<4>> ekf(
-          posefuse::ConstantVelocity2<double>(1.0), fix);
-      Eigen::Vector4d x0;
-      x0 << f.z[0], 0, 0;
-      ekf.reset(x0, Eigen::Matrix4d::Identity());
-      for (std::size_t k = 0; k < 128; ++k) {
-        (void)ekf.predict(posefuse::NoControl{}, 0.1);
-        v.push_back(ekf.covariance());
-        (void)ekf.update_with(fix, f.z[k]);
-        v.push_back(ekf.covariance());
-      }
+      static_assert(N == 15);
+      Pose15::PosefuseNoMemo f;
+      record(
+          f, [&f](std::size_t) { (void)f.ekf.predict(posefuse::NoControl{}, Pose15::kDt); },
+          [&f](std::size_t k) { (void)f.ekf.template update<0>(Pose15::measurements()[k]); });
     }
     return v;
   }();
@@ -217,9 +661,6 @@ void BM_PsdCheck(benchmark::State& state) {
     k = (k + 1) & 255;
   }
 }
-BENCHMARK_TEMPLATE(BM_PsdCheck, 2)->Name("BM_PsdCheck/2");
-BENCHMARK_TEMPLATE(BM_PsdCheck, 4)->Name("BM_PsdCheck/4");
-
 template <int N>
 void BM_PsdCheck_Reference(benchmark::State& state) {
   const auto& P = filter_covariances<N>();
@@ -229,7 +670,23 @@ void BM_PsdCheck_Reference(benchmark::State& state) {
     k = (k + 1) & 255;
   }
 }
-BENCHMARK_TEMPLATE(BM_PsdCheck_Reference, 2)->Name("BM_PsdCheck_Reference/2");
-BENCHMARK_TEMPLATE(BM_PsdCheck_Reference, 4)->Name("BM_PsdCheck_Reference/4");
+
+const bool registered = [] {
+  register_workload<Seed000<false>>("BM_Seed000Ekf_Step", true);
+  benchmark::RegisterBenchmark("BM_Seed000Ekf_Step/posefuse_recompute",
+                               BM_Step<Seed000<false>, Seed000Recompute>);
+  register_workload<Seed000<true>>("BM_Seed000Kitti_Step", false);
+  register_workload<ConstantVelocity<false>>("BM_ConstantVelocityEkf_Step", true);
+  register_workload<ConstantVelocity<true>>("BM_ConstantVelocityKitti_Step", false);
+  register_workload<UnicyclePoseFix>("BM_UnicyclePoseFix_Step", false);
+  register_workload<Pose15>("BM_Pose15_Step", true);
+  benchmark::RegisterBenchmark("BM_PsdCheck/2", BM_PsdCheck<2>);
+  benchmark::RegisterBenchmark("BM_PsdCheck/4", BM_PsdCheck<4>);
+  benchmark::RegisterBenchmark("BM_PsdCheck/15", BM_PsdCheck<15>);
+  benchmark::RegisterBenchmark("BM_PsdCheck_Reference/2", BM_PsdCheck_Reference<2>);
+  benchmark::RegisterBenchmark("BM_PsdCheck_Reference/4", BM_PsdCheck_Reference<4>);
+  benchmark::RegisterBenchmark("BM_PsdCheck_Reference/15", BM_PsdCheck_Reference<15>);
+  return true;
+}();
 
 }  // namespace

@@ -21,6 +21,7 @@
 
 #include <Eigen/Core>
 #include <concepts>
+#include <cstddef>
 #include <type_traits>
 
 namespace posefuse {
@@ -245,6 +246,75 @@ inline constexpr bool is_time_invariant_v = [] {
   }
 }();
 
+/// A MotionModel that propagates a covariance through its own Jacobian
+/// itself: `propagate(P, x, u, dt)` returns \f$ F P F^\top \f$ (without the
+/// process noise), \f$ F \f$ = `jacobian(x, u, dt)`, computed from F's known
+/// structure (constant velocity: a few additions instead of two dense
+/// products). Optional: Ekf::predict uses it when present;
+/// testing::check_motion_model checks it against \f$ F P F^\top \f$.
+template <class M>
+concept HasPropagate =
+    MotionModel<M> &&
+    requires(const M& m, const CovarianceOf<typename M::State>& P, const typename M::State& x,
+             const typename M::Control& u, ScalarOf<typename M::State> dt) {
+      { m.propagate(P, x, u, dt) } -> ReturnsExactly<CovarianceOf<typename M::State>>;
+    };
+
+/// A HasLinearize model whose `linearize()` result also propagates a
+/// covariance: `lin.propagate(P)` returns \f$ F P F^\top \f$ with F =
+/// `lin.jacobian` (so the work shared with the Jacobian, e.g. a heading's
+/// sine and cosine, is not repeated). Optional, checked like HasPropagate.
+template <class M>
+concept HasLinearizePropagate =
+    HasLinearize<M> &&
+    requires(const M& m, const typename M::State& x, const typename M::Control& u,
+             ScalarOf<typename M::State> dt, const CovarianceOf<typename M::State>& P) {
+      { m.linearize(x, u, dt).propagate(P) } -> ReturnsExactly<CovarianceOf<typename M::State>>;
+    };
+
+namespace detail {
+/// True when `H::kSelection` exists.
+template <class H>
+concept DeclaresSelection = requires { H::kSelection; };
+
+/// Whether a declared selection is well formed: one index per measurement
+/// component, each in [0, state Dim), no index twice.
+template <class H>
+consteval bool selection_well_formed() {
+  if constexpr (!DeclaresSelection<H>) {
+    return false;
+  } else {
+    constexpr auto sel = H::kSelection;
+    if (int(sel.size()) != DimOf<typename H::Measurement>) return false;
+    for (std::size_t i = 0; i < sel.size(); ++i) {
+      if (sel[i] < 0 || sel[i] >= DimOf<typename H::State>) return false;
+      for (std::size_t j = 0; j < i; ++j)
+        if (sel[i] == sel[j]) return false;
+    }
+    return true;
+  }
+}
+}  // namespace detail
+
+/// Measurement models whose Jacobian is a *selection* of state components,
+/// \f$ H_{k,j} = 1 \f$ if \f$ j = s_k \f$ and 0 otherwise (a position fix
+/// \f$ [I\;0] \f$, a heading fix \f$ [0\;0\;1] \f$, a GNSS position of a
+/// larger state), may declare it with
+/// `static constexpr std::array<int, Measurement::Dim> kSelection = {s_0, ...};`.
+/// Estimators then read rows and columns of P instead of multiplying by H.
+/// The declaration must match `jacobian(x)` at every x;
+/// testing::check_measurement_model checks that it does. A declaration of
+/// the wrong length, an index outside the state or one given twice fails to
+/// compile in the estimator (check_measurement_model()).
+template <class H>
+inline constexpr bool has_selection_v = [] {
+  if constexpr (requires { typename H::State; typename H::Measurement; }) {
+    return detail::DeclaresSelection<H>;
+  } else {
+    return false;
+  }
+}();
+
 /// Asserts each requirement of MotionModel separately, so that the compiler's
 /// message names the one that is missing. Use in a `static_assert` or call
 /// from a template that takes a motion model.
@@ -316,6 +386,11 @@ consteval bool check_measurement_model() {
                     "posefuse: a measurement model needs `Matrix<Scalar, Measurement::Dim, "
                     "Measurement::Dim> noise() const` or, for noise that depends on the state, "
                     "`noise(const State&) const`");
+      if constexpr (detail::DeclaresSelection<H>) {
+        static_assert(detail::selection_well_formed<H>(),
+                      "posefuse: a measurement model's kSelection must list Measurement::Dim "
+                      "distinct state indices, each in [0, State::Dim)");
+      }
     }
   }
   return MeasurementModel<H>;

@@ -130,12 +130,171 @@ template <class T>
          std::numeric_limits<T>::epsilon();
 }
 
+/// The diagonal shift of psd_shifted_ldlt_accepts for size n, relative to
+/// each variance: \f$ \delta_n = 2\,(2 n(n+1) + 19 n + 3)\,\epsilon \f$
+/// (double: 3.4e-13 at n = 15; float: 1.8e-4 at n = 15).
+template <class T>
+[[nodiscard]] constexpr T psd_shift(int n) noexcept {
+  return T(2) * (T(2) * T(n) * T(n + 1) + T(19) * T(n) + T(3)) * std::numeric_limits<T>::epsilon();
+}
+
+/// The fast path of is_positive_semidefinite for fixed sizes above
+/// kPsdFastMaxSize: a sufficient condition for the reference (true only when
+/// psd_reference is certain to accept `m`, as definite); false means
+/// "undecided". After the checks of psd_fast_accepts (exact symmetry,
+/// variances in range), an unpivoted LDLT of the *shifted* matrix
+/// \f$ M - \delta_n D \f$ (\f$ D = \mathrm{diag}(M) \f$, psd_shift) must
+/// complete with positive pivots (Rump's verification of positive
+/// definiteness by a floating-point Cholesky of a shifted matrix: Rump,
+/// BIT 46 (2006) 433-452).
+///
+/// Why: the computed factors satisfy \f$ \hat L \hat D \hat L^\top = M - \delta_n
+/// D + \eta + \Delta M \f$ with \f$ |\Delta M| \le \gamma_{n+1} |\hat L|
+/// |\hat D| |\hat L^\top| \f$ (Higham, *Accuracy and Stability*, Thm 10.3
+/// and its LDLT form) and \f$ |\eta_{ii}| \le 2.1\,\epsilon\, m_{ii} \f$
+/// (rounding of the shifted diagonal). With positive pivots, Cauchy-Schwarz
+/// bounds \f$ (|\hat L||\hat D||\hat L^\top|)_{ij} \f$ by
+/// \f$ \sqrt{m_{ii} m_{jj}} (1 + 3\epsilon) / (1 - \gamma_{n+1}) \f$, so in
+/// the scale-free form C, \f$ C - \delta_n I + E \succeq 0 \f$ with
+/// \f$ \|E\|_2 \lesssim (n(n+1) + 2.1)\epsilon \f$, i.e. \f$ \lambda_{\min}(C)
+/// \gtrsim \delta_n - (n(n+1) + 2.1)\epsilon \f$. The reference's completely
+/// pivoted LDLT is exact for a matrix within \f$ (n(n+1) + 3n)\epsilon \f$
+/// of C (see psd_fast_accepts), so its pivots exceed \f$ \delta_n - (2n(n+1)
+/// + 3n + 2.1)\epsilon > 16 n \epsilon \f$, the tolerance, with a factor 2 to
+/// spare in \f$ \delta_n \f$: the reference accepts, as definite. The range of
+/// the variances keeps every rounding error relative (underflow in a product
+/// is far below \f$ \epsilon \sqrt{m_{ii} m_{jj}} \f$); an overflow, NaN or
+/// Inf makes a later pivot NaN or \f$ -\infty \f$, which fails.
+/// tests/filters/test_ekf_fast_paths.cpp checks the agreement with the
+/// reference on random PSD, indefinite and near-singular matrices.
+template <class Derived>
+[[nodiscard]] bool psd_shifted_ldlt_accepts(const Eigen::MatrixBase<Derived>& m) {
+  using T = typename Derived::Scalar;
+  constexpr int N = Derived::RowsAtCompileTime;
+  constexpr T delta = psd_shift<T>(N);
+  if constexpr (!(delta < T(0.5))) {
+    return false;
+  } else {
+    const T min_diag = std::sqrt(std::numeric_limits<T>::min()) / std::numeric_limits<T>::epsilon();
+    const T max_diag = std::sqrt(std::numeric_limits<T>::max()) * std::numeric_limits<T>::epsilon();
+    T s[N][N];  // lower triangle of the Schur complements of the shifted matrix
+    for (int i = 0; i < N; ++i) {
+      const T d = m(i, i);
+      if (!(d >= min_diag && d <= max_diag)) return false;
+      s[i][i] = d - delta * d;
+      for (int j = 0; j < i; ++j) {
+        if (!(m(i, j) == m(j, i))) return false;
+        s[i][j] = m(i, j);
+      }
+    }
+    for (int k = 0; k < N; ++k) {
+      const T d = s[k][k];
+      if (!(d > T(0))) return false;
+      const T inv = T(1) / d;
+      T c[N];  // column k, contiguous so that the row updates vectorise
+      for (int j = k + 1; j < N; ++j) c[j] = s[j][k];
+      for (int i = k + 1; i < N; ++i) {
+        const T l = c[i] * inv;
+        for (int j = k + 1; j <= i; ++j) s[i][j] -= l * c[j];
+      }
+    }
+    return true;
+  }
+}
+
+/// Division-free first try of the fast path for sizes 3 and 4: Sylvester's
+/// criterion with margins. True only when the reference (psd_reference) is
+/// certain to accept `m` as definite; false means "undecided".
+///
+/// Checks: `m` exactly symmetric, every variance in \f$ [2^{-e}, 2^{e}] \f$
+/// (e = (max_exponent - 24) / 2n: double 125 at n = 4, float 13),
+/// \f$ m_{ij}^2 \le m_{ii} m_{jj} \f$, then the leading principal minors
+/// \f$ D_k \f$ (cofactor / Laplace expansion) against \f$ \theta_k \prod_{i<k}
+/// m_{ii} \f$ with \f$ \theta_k = 12 k\,k!\,\epsilon \f$ for k < n and
+/// \f$ \theta_n = 12 n\,n!\,\epsilon + 3\delta_n \f$ (\f$ \delta_n \f$ = psd_shift).
+///
+/// Why: each expansion sums the k! Leibniz products, each after at most 3k
+/// roundings, so \f$ |\hat D_k - D_k| \le \gamma_{3k}\,\mathrm{per}|M_k| \le
+/// \gamma_{3k}\,k! \prod m_{ii} (1 + k\epsilon) \f$ (the permanent bounded by
+/// the entry check). Hence every exact leading minor is positive (Sylvester:
+/// M, and its scale-free form C, are positive definite) and
+/// \f$ \det C = D_n / \prod m_{ii} \ge 3\delta_n \f$ (to first order). The
+/// other n - 1 eigenvalues of C have a product at most
+/// \f$ (\mathrm{tr}\,C / (n-1))^{n-1} = (n/(n-1))^{n-1} < e \f$, so
+/// \f$ \lambda_{\min}(C) > \delta_n \f$, which (see psd_shifted_ldlt_accepts)
+/// makes the reference accept. The variance range keeps every product
+/// normal or its underflow far below the margins; NaN fails a comparison.
+template <class Derived>
+[[nodiscard]] bool psd_minors_accept(const Eigen::MatrixBase<Derived>& m) {
+  using T = typename Derived::Scalar;
+  constexpr int N = Derived::RowsAtCompileTime;
+  static_assert(N == 3 || N == 4);
+  constexpr T eps = std::numeric_limits<T>::epsilon();
+  constexpr T fact = N == 3 ? T(6) : T(24);
+  constexpr T theta3 = T(12 * 3 * 6) * eps + (N == 3 ? T(3) * psd_shift<T>(3) : T(0));
+  constexpr T theta4 = T(12 * 4 * 24) * eps + T(3) * psd_shift<T>(4);
+  constexpr T theta2 = T(12 * 2 * 2) * eps;
+  (void)fact;
+  if constexpr (!(theta3 < T(0.5) && theta4 < T(0.5))) {
+    return false;
+  } else {
+    // 2^-e and 2^e with e = (max_exponent - 24) / (2N): every product of
+    // up to N entries (and the thresholds) stays a normal number (double:
+    // 2^-125 .. 2^125 at N = 4; float: 2^-13 .. 2^13).
+    constexpr int e = (std::numeric_limits<T>::max_exponent - 24) / (2 * N);
+    constexpr T hi = [] {
+      T v = T(1);
+      for (int i = 0; i < e; ++i) v *= T(2);
+      return v;
+    }();
+    constexpr T lo = T(1) / hi;
+    T a[N][N];
+    for (int i = 0; i < N; ++i) {
+      a[i][i] = m(i, i);
+      if (!(a[i][i] >= lo && a[i][i] <= hi)) return false;
+    }
+    for (int i = 0; i < N; ++i)
+      for (int j = 0; j < i; ++j) {
+        const T v = m(i, j);
+        if (!(v == m(j, i) && v * v <= a[i][i] * a[j][j])) return false;
+        a[i][j] = a[j][i] = v;
+      }
+    const T p2 = a[0][0] * a[1][1];
+    const T d2 = p2 - a[0][1] * a[0][1];
+    if (!(d2 >= theta2 * p2)) return false;
+    // 2x2 minors of rows 0, 1 (columns c0 < c1).
+    const T m01 = d2;
+    const T m02 = a[0][0] * a[1][2] - a[0][2] * a[1][0];
+    const T m12 = a[0][1] * a[1][2] - a[0][2] * a[1][1];
+    const T d3 = a[2][0] * m12 - a[2][1] * m02 + a[2][2] * m01;
+    const T p3 = p2 * a[2][2];
+    if constexpr (N == 3) {
+      return d3 >= theta3 * p3;
+    } else {
+      if (!(d3 >= T(12 * 3 * 6) * eps * p3)) return false;
+      const T m03 = a[0][0] * a[1][3] - a[0][3] * a[1][0];
+      const T m13 = a[0][1] * a[1][3] - a[0][3] * a[1][1];
+      const T m23 = a[0][2] * a[1][3] - a[0][3] * a[1][2];
+      // Complementary 2x2 minors of rows 2, 3.
+      const T n23 = a[2][2] * a[3][3] - a[2][3] * a[3][2];
+      const T n13 = a[2][1] * a[3][3] - a[2][3] * a[3][1];
+      const T n12 = a[2][1] * a[3][2] - a[2][2] * a[3][1];
+      const T n03 = a[2][0] * a[3][3] - a[2][3] * a[3][0];
+      const T n02 = a[2][0] * a[3][2] - a[2][2] * a[3][0];
+      const T n01 = a[2][0] * a[3][1] - a[2][1] * a[3][0];
+      const T d4 = m01 * n23 - m02 * n13 + m03 * n12 + m12 * n03 - m13 * n02 + m23 * n01;
+      return d4 >= theta4 * (p3 * a[3][3]);
+    }
+  }
+}
+
 /// A sufficient condition for the criterion of is_positive_definite (and so
 /// of is_positive_semidefinite), cheaper than the reference: true only when
 /// the reference test (psd_reference) is certain to accept `m` as positive
 /// definite; false means "undecided", never "indefinite".
 ///
-/// For fixed sizes 1..6: `m` exactly symmetric, every diagonal entry in
+/// Sizes above 6 take psd_shifted_ldlt_accepts; sizes 3 and 4 first try
+/// psd_minors_accept (no division). For fixed sizes 1..6: `m` exactly symmetric, every diagonal entry in
 /// [sqrt(min) / eps, sqrt(max) * eps] (no overflow or underflow below), then
 /// an LDLT of `m` in its given order, without pivoting, square roots or any
 /// division but one per pivot, in which every pivot of the scale-free form,
@@ -164,8 +323,10 @@ template <class Derived>
   using T = typename Derived::Scalar;
   constexpr int N = Derived::RowsAtCompileTime;
   if constexpr (N == Eigen::Dynamic || N != Derived::ColsAtCompileTime || N < 1 ||
-                N > kPsdFastMaxSize || !std::is_floating_point_v<T>) {
+                !std::is_floating_point_v<T>) {
     return false;
+  } else if constexpr (N > kPsdFastMaxSize) {
+    return psd_shifted_ldlt_accepts(m);
   } else {
     constexpr T beta = psd_fast_min_pivot<T>(N);
     if constexpr (!(beta < T(1))) {
@@ -183,6 +344,9 @@ template <class Derived>
               m(1, 1) <= max_diag && m(1, 0) == m(0, 1)))
           return false;
         return m(1, 0) * m(1, 0) <= (T(1) - beta) * (m(0, 0) * m(1, 1));
+      }
+      if constexpr (N == 3 || N == 4) {
+        if (psd_minors_accept(m)) return true;  // else the LDLT below decides
       }
       constexpr T l2 = T(kPsdFastMaxMultiplier) * T(kPsdFastMaxMultiplier);
       T diag[N];

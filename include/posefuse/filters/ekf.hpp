@@ -10,14 +10,16 @@
 ///     K = \bar P H^\top S^{-1} \f]
 /// \f[ x = \bar x \boxplus K r,\quad
 ///     P = (I - K H) \bar P (I - K H)^\top + K R_h K^\top \f]
-/// The covariance update is Joseph's form, then symmetrised, so P stays
-/// symmetric positive semi-definite under round-off. \f$ R_h \f$ is the
+/// The covariance update is Joseph's form by default (or the standard
+/// \f$ (I - K H) \bar P \f$, EkfOptions), computed as one triangle and
+/// mirrored, so P stays exactly symmetric, and positive semi-definite under
+/// round-off (each result is checked, below). \f$ R_h \f$ is the
 /// model's `noise()`, or `noise(x)` at the prior state when the model has it
 /// (state-dependent noise, core/concepts.hpp).
 ///
 /// **Solving with S.** For 1x1 and 2x2 innovations S is tested by
 /// Sylvester's criterion and inverted in closed form (a few flops). Larger
-/// ones are factorised, \f$ S = L L^\top \f$, and K and the NIS
+/// ones are factorised, \f$ S = L D L^\top \f$ (no square roots), and K and the NIS
 /// \f$ r^\top S^{-1} r \f$ are computed by solving with L; no inverse is
 /// formed. Either way S counts as positive definite only when every pivot is
 /// above round-off: \f$ L_{ii}^2 > n\,\epsilon\,S_{ii} \f$ (2x2:
@@ -32,6 +34,13 @@
 /// (e.g. position and heading of a pose); the returned UpdateResult keeps r,
 /// S and the NIS, from which the caller can tell which part failed.
 ///
+/// **Compile-time options and structure.** BasicEkf<Options, Motion,
+/// Sensors...> takes EkfOptions (covariance form, NIS policy, Jacobian
+/// recording for smoothers, steady-state gain memo); Ekf<Motion, Sensors...>
+/// uses the defaults. Selection Jacobians (`kSelection`), identity
+/// Jacobians and model-supplied covariance propagation (`propagate`) are
+/// used at compile time; see BasicEkf.
+///
 /// **Before reset().** A filter constructed without a belief has none:
 /// predict() and every update return FilterStatus::kNotInitialised and change
 /// nothing until reset() is called (initialised()).
@@ -41,11 +50,11 @@
 /// reproduce it (planar_displacement.hpp, position.hpp) keep that naming in
 /// their parameters.
 
-#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <posefuse/core/concepts.hpp>
 #include <posefuse/core/error.hpp>
@@ -124,7 +133,7 @@ consteval bool state_matches() {
 
 /// The positive-definiteness test and the solves with an innovation
 /// covariance S (see the file comment). Sizes 1 and 2 keep S⁻¹ in closed
-/// form; larger sizes keep the Cholesky factor and never form S⁻¹.
+/// form; larger sizes keep the factors of S = L D Lᵀ and never form S⁻¹.
 template <class Mat, int N = Mat::RowsAtCompileTime>
 class SpdSolver {
   using T = typename Mat::Scalar;
@@ -132,7 +141,7 @@ class SpdSolver {
 
  public:
   /// Factorises S. @return false (solver unusable) unless S is positive definite
-  [[nodiscard]] bool compute(const Mat& S) {
+  [[nodiscard, gnu::always_inline]] bool compute(const Mat& S) {
     if constexpr (N == 1) {
       if (!(S(0, 0) > T(0))) return false;
       inv_(0, 0) = T(1) / S(0, 0);
@@ -148,31 +157,63 @@ class SpdSolver {
       inv_(1, 0) = -S(1, 0) * r;
       return true;
     } else {
-      llt_.compute(S);
-      if (llt_.info() != Eigen::Success) return false;
+      // S = L D L^T (L unit lower triangular), column by column, from the
+      // lower triangle of S; no square roots, 1 / d_j kept so that the
+      // solves below multiply. d_j is the squared Cholesky pivot L_jj^2.
       const T tol = T(N) * std::numeric_limits<T>::epsilon();
-      const auto& L = llt_.matrixLLT();
-      for (int i = 0; i < N; ++i)
-        if (!(L(i, i) * L(i, i) > tol * S(i, i))) return false;
+      for (int j = 0; j < N; ++j) {
+        T d = S(j, j);
+        for (int k = 0; k < j; ++k) d -= L_(j, k) * LD_(j, k);
+        // The pivot criterion of the file comment (NaN fails).
+        if (!(d > tol * S(j, j))) return false;
+        inv_diag_(j) = T(1) / d;
+        for (int i = j + 1; i < N; ++i) {
+          T v = S(i, j);
+          for (int k = 0; k < j; ++k) v -= L_(i, k) * LD_(j, k);
+          LD_(i, j) = v;                    // L_ij d_j
+          L_(i, j) = v * inv_diag_(j);
+        }
+      }
       return true;
     }
   }
-  /// \f$ r^\top S^{-1} r \f$.
-  [[nodiscard]] T nis(const Vec& r) const {
+  /// \f$ r^\top S^{-1} r = \sum_j y_j^2 / d_j,\; y = L^{-1} r \f$.
+  [[nodiscard, gnu::always_inline]] T nis(const Vec& r) const {
     if constexpr (N <= 2) {
       return r.dot(inv_ * r);
     } else {
-      return r.dot(llt_.solve(r));
+      Vec y;
+      T sum = T(0);
+      for (int j = 0; j < N; ++j) {
+        T v = r(j);
+        for (int k = 0; k < j; ++k) v -= L_(j, k) * y(k);
+        y(j) = v;
+        sum += v * v * inv_diag_(j);
+      }
+      return sum;
     }
   }
-  /// \f$ A S^{-1} \f$ for an M x N matrix A.
+  /// \f$ A S^{-1} \f$ for an M x N matrix A (rows solved with L, then L^T).
   template <int M>
-  [[nodiscard]] Eigen::Matrix<T, M, N> right_solve(const Eigen::Matrix<T, M, N>& A) const {
+  [[nodiscard, gnu::always_inline]] Eigen::Matrix<T, M, N> right_solve(
+      const Eigen::Matrix<T, M, N>& A) const {
     if constexpr (N <= 2) {
       return A * inv_;
     } else {
-      // A S^-1 = (S^-1 A^T)^T, S symmetric.
-      return llt_.solve(A.transpose()).transpose();
+      // X S = A  <=>  (X L D) L^T = A: Y L^T = A forward, Y D^-1, then
+      // X L = Y D^-1 backward (L unit lower triangular).
+      Eigen::Matrix<T, M, N> X;
+      for (int j = 0; j < N; ++j) {
+        Eigen::Matrix<T, M, 1> v = A.col(j);
+        for (int k = 0; k < j; ++k) v -= L_(j, k) * X.col(k);
+        X.col(j) = v;
+      }
+      for (int j = N - 1; j >= 0; --j) {
+        Eigen::Matrix<T, M, 1> v = X.col(j) * inv_diag_(j);
+        for (int k = j + 1; k < N; ++k) v -= L_(k, j) * X.col(k);
+        X.col(j) = v;
+      }
+      return X;
     }
   }
 
@@ -186,8 +227,26 @@ class SpdSolver {
       return Empty{};
     }
   }
+  using Factor = std::conditional_t<(N <= 2), Empty, Mat>;
+  using InvDiag = std::conditional_t<(N <= 2), Empty, Vec>;
+  static Factor zero_factor() {
+    if constexpr (N <= 2) {
+      return Empty{};
+    } else {
+      return Mat::Zero();
+    }
+  }
+  static InvDiag zero_inv_diag() {
+    if constexpr (N <= 2) {
+      return Empty{};
+    } else {
+      return Vec::Zero();
+    }
+  }
   [[no_unique_address]] Inverse inv_ = zero_inverse();
-  [[no_unique_address]] std::conditional_t<(N <= 2), Empty, Eigen::LLT<Mat>> llt_{};
+  [[no_unique_address]] Factor L_ = zero_factor();   // unit lower triangular L
+  [[no_unique_address]] Factor LD_ = zero_factor();  // L_ij d_j (i > j)
+  [[no_unique_address]] InvDiag inv_diag_ = zero_inv_diag();
 };
 
 /// Placeholder measurement type for update_with() with a type that names none.
@@ -203,11 +262,92 @@ struct measurement_of<H> {
 };
 }  // namespace detail
 
-/// An EKF over `Motion` with measurement models `Sensors...`.
+/// How an Ekf forms the posterior covariance (EkfOptions::kCovarianceUpdate).
+enum class CovarianceUpdate : std::uint8_t {
+  /// Joseph's form \f$ (I - K H) P (I - K H)^\top + K R K^\top \f$ (Bucy &
+  /// Joseph 1968; Grewal & Andrews, *Kalman Filtering*, 4th ed., eq. 4.23):
+  /// PSD for any gain, so round-off in K does not make P indefinite. The
+  /// default. Cost over kStandard: one Dim x Dim x M product more (one
+  /// triangle of it), e.g. +20 multiplications for Dim 4, M 2.
+  kJoseph,
+  /// The textbook \f$ (I - K H) P \f$ (one triangle, mirrored): fewer
+  /// flops; exact only for the optimal gain, so round-off can leave P
+  /// indefinite on ill-conditioned problems (the filter then refuses the
+  /// step with kNotPositiveDefinite rather than store it).
+  kStandard,
+};
+
+/// When an Ekf computes the NIS \f$ r^\top S^{-1} r \f$ of an update
+/// (EkfOptions::kNis).
+enum class NisPolicy : std::uint8_t {
+  kAlways,     ///< every update: UpdateResult::nis is always set (the default)
+  kWhenGated,  ///< only when a NIS gate is finite or a gate functor takes the
+               ///< NIS; otherwise UpdateResult::nis stays NaN (saves one solve with S)
+};
+
+/// Compile-time options of BasicEkf. Derive from it and hide the members you
+/// change; the defaults are the safe choices, and `Ekf<Motion, Sensors...>`
+/// is BasicEkf with these defaults:
+/// ```cpp
+/// struct FastOptions : posefuse::EkfOptions {
+///   static constexpr auto kNis = posefuse::NisPolicy::kWhenGated;
+///   static constexpr bool kRecordJacobian = false;  // no smoother reads last_jacobian()
+/// };
+/// posefuse::BasicEkf<FastOptions, Motion, Sensor> ekf(motion, sensor);
+/// ```
+struct EkfOptions {
+  /// Posterior covariance form (Joseph by default; see CovarianceUpdate).
+  static constexpr CovarianceUpdate kCovarianceUpdate = CovarianceUpdate::kJoseph;
+  /// NIS computation (always by default; see NisPolicy).
+  static constexpr NisPolicy kNis = NisPolicy::kAlways;
+  /// Keep the state Jacobian F of the last applied prediction for
+  /// last_jacobian() (RTS smoothing). Cost: one Dim x Dim copy per predict,
+  /// plus a `jacobian()` call for models that propagate the covariance
+  /// themselves (HasPropagate). Off: last_jacobian() does not compile.
+  static constexpr bool kRecordJacobian = true;
+  /// Steady-state gain memo for time-invariant models (kTimeInvariant):
+  /// keep the covariance half of the update and reuse it, bit for bit,
+  /// while P repeats. Cost: one Dim x Dim comparison per update and, per
+  /// model, a Dim x Dim copy of P whenever the gain is recomputed.
+  static constexpr bool kGainMemo = true;
+};
+
+/// A type usable as BasicEkf's options (see EkfOptions).
+template <class O>
+concept EkfOptionSet = requires {
+  { O::kCovarianceUpdate } -> std::convertible_to<CovarianceUpdate>;
+  { O::kNis } -> std::convertible_to<NisPolicy>;
+  { O::kRecordJacobian } -> std::convertible_to<bool>;
+  { O::kGainMemo } -> std::convertible_to<bool>;
+};
+
+/// An EKF over `Motion` with measurement models `Sensors...` and
+/// compile-time options `Options` (EkfOptions or a type derived from it);
+/// `Ekf<Motion, Sensors...>` is the usual spelling with the default options.
+///
+/// **Structure used at compile time** (each declared by the model, each
+/// checked against the model's own Jacobian by testing/conformance.hpp):
+/// `kIdentityJacobian` skips products with F or H; a measurement model's
+/// `kSelection` (has_selection_v) makes the update read rows and columns of
+/// P instead of multiplying by H (also inside the Joseph form); a motion
+/// model's `propagate(P, x, u, dt)` (HasPropagate) or its linearisation's
+/// `propagate(P)` (HasLinearizePropagate) replaces \f$ F P F^\top \f$.
+/// Symmetric results are computed as one triangle and mirrored, so P is
+/// exactly symmetric after every applied step.
+///
+/// **Safety at one check per result**: every applied step's covariance
+/// passed is_positive_semidefinite() (core/gaussian.hpp), which also
+/// refuses NaN and Inf; the state and the innovation are checked for
+/// finiteness. A refused step returns its status and leaves the filter
+/// bit-identical.
+/// @tparam Options an EkfOptionSet
 /// @tparam Motion  a posefuse::MotionModel
 /// @tparam Sensors posefuse::MeasurementModel's with the same State
-template <class Motion, class... Sensors>
-class Ekf {
+template <class Options, class Motion, class... Sensors>
+class BasicEkf {
+  static_assert(EkfOptionSet<Options>,
+                "posefuse::BasicEkf: Options must name kCovarianceUpdate, kNis, "
+                "kRecordJacobian and kGainMemo (derive it from posefuse::EkfOptions)");
   static_assert(check_motion_model<Motion>(), "posefuse::Ekf: see the message above");
   static_assert((check_measurement_model<Sensors>() && ...),
                 "posefuse::Ekf: see the message above");
@@ -215,6 +355,7 @@ class Ekf {
                 "posefuse::Ekf: every measurement model must have the motion model's State type");
 
  public:
+  using OptionsType = Options;
   using MotionType = Motion;
   using StateType = typename Motion::State;
   using Control = typename Motion::Control;
@@ -227,7 +368,7 @@ class Ekf {
 
   /// A filter with models but no belief yet: call reset() before the first
   /// step (until then every step returns kNotInitialised).
-  explicit Ekf(Motion motion, Sensors... sensors)
+  explicit BasicEkf(Motion motion, Sensors... sensors)
       : motion_(std::move(motion)), sensors_(std::move(sensors)...) {
     gates_.fill(std::numeric_limits<Scalar>::infinity());
   }
@@ -259,32 +400,36 @@ class Ekf {
     if (dt < Scalar(0)) return FilterStatus::kInvalidInput;
     StateType x_new = detail::zero_state<StateType>();
     Covariance P_new;
+    [[maybe_unused]] Covariance F_new;  // recorded for the smoother (kRecordJacobian)
     if constexpr (has_identity_jacobian_v<Motion>) {
       x_new = motion_.predict(x_, u, dt);
       P_new = P_ + Covariance(motion_.noise(x_, u, dt));
-      if (!minus(x_new, x_).allFinite() || !P_new.allFinite()) return FilterStatus::kNonFinite;
-      P_new = symmetrised(P_new);
-      if (!is_positive_semidefinite(P_new)) return FilterStatus::kNotPositiveDefinite;
-      // F_ stays the identity it was initialised to.
     } else if constexpr (HasLinearize<Motion>) {
-      // One model call (see HasLinearize, core/concepts.hpp); the same values as below.
+      // One model call (see HasLinearize, core/concepts.hpp).
       const auto lin = motion_.linearize(x_, u, dt);
       x_new = lin.state;
-      const Covariance F = lin.jacobian;
-      P_new = F * P_ * F.transpose() + Covariance(lin.noise);
-      if (!minus(x_new, x_).allFinite() || !P_new.allFinite()) return FilterStatus::kNonFinite;
-      P_new = symmetrised(P_new);
-      if (!is_positive_semidefinite(P_new)) return FilterStatus::kNotPositiveDefinite;
-      F_ = F;  // recorded for the smoother only when the step is applied
+      if constexpr (HasLinearizePropagate<Motion>) {
+        P_new = Covariance(lin.propagate(P_)) + Covariance(lin.noise);
+      } else {
+        P_new = sandwich(Covariance(lin.jacobian), Covariance(lin.noise));
+      }
+      if constexpr (Options::kRecordJacobian) F_new = lin.jacobian;
+    } else if constexpr (HasPropagate<Motion>) {
+      x_new = motion_.predict(x_, u, dt);
+      P_new = Covariance(motion_.propagate(P_, x_, u, dt)) + Covariance(motion_.noise(x_, u, dt));
+      if constexpr (Options::kRecordJacobian) F_new = motion_.jacobian(x_, u, dt);
     } else {
       x_new = motion_.predict(x_, u, dt);
       const Covariance F = motion_.jacobian(x_, u, dt);
-      P_new = F * P_ * F.transpose() + Covariance(motion_.noise(x_, u, dt));
-      if (!minus(x_new, x_).allFinite() || !P_new.allFinite()) return FilterStatus::kNonFinite;
-      P_new = symmetrised(P_new);
-      if (!is_positive_semidefinite(P_new)) return FilterStatus::kNotPositiveDefinite;
-      F_ = F;  // recorded for the smoother only when the step is applied
+      P_new = sandwich(F, Covariance(motion_.noise(x_, u, dt)));
+      if constexpr (Options::kRecordJacobian) F_new = F;
     }
+    if (!finite(minus(x_new, x_))) return FilterStatus::kNonFinite;
+    mirror_lower(P_new);
+    // Refuses NaN and Inf too; the finiteness pass runs only to name the failure.
+    if (!is_positive_semidefinite(P_new))
+      return P_new.allFinite() ? FilterStatus::kNotPositiveDefinite : FilterStatus::kNonFinite;
+    if constexpr (Options::kRecordJacobian && !has_identity_jacobian_v<Motion>) F_ = F_new;
     x_ = x_new;
     P_ = P_new;
     return FilterStatus::kApplied;
@@ -389,8 +534,13 @@ class Ekf {
   [[nodiscard]] const Covariance& covariance() const noexcept { return P_; }
   /// State and covariance as a Gaussian.
   [[nodiscard]] Belief belief() const { return Belief(x_, P_); }
-  /// The state Jacobian F of the last applied prediction (for smoothing).
-  [[nodiscard]] const Covariance& last_jacobian() const noexcept { return F_; }
+  /// The state Jacobian F of the last applied prediction (for smoothing;
+  /// only with Options::kRecordJacobian).
+  [[nodiscard]] const Covariance& last_jacobian() const noexcept
+    requires(Options::kRecordJacobian)
+  {
+    return F_;
+  }
   /// The motion model.
   [[nodiscard]] const Motion& motion() const noexcept { return motion_; }
   /// The I-th measurement model.
@@ -409,11 +559,11 @@ class Ekf {
     using H = SensorType<I>;
     if (!initialised_) return fail(UpdateResult<H>{}, FilterStatus::kNotInitialised);
     const H& sensor = std::get<I>(sensors_);
-    if constexpr (is_time_invariant_v<H>) {
+    if constexpr (Options::kGainMemo && is_time_invariant_v<H>) {
       // The covariance part depends on P alone: reuse it while P repeats
       // (a converged, steady-state filter), bit for bit what it would compute.
       GainMemo<H>& memo = std::get<I>(memos_);
-      if (!memo.valid || memo.P_in != P_) {
+      if (!memo.valid || !same_values(memo.P_in, P_)) {
         memo.valid = false;
         const FilterStatus s = covariance_update(sensor, memo.gain);
         if (s != FilterStatus::kApplied) return fail(UpdateResult<H>{}, s);
@@ -447,32 +597,75 @@ class Ekf {
     Gain<H> gain;
   };
 
+  /// The state components a measurement model selects, when its Jacobian is
+  /// a selection: H = I (kIdentityJacobian with Measurement::Dim == Dim) or
+  /// its declared kSelection.
   template <class H>
-  FilterStatus covariance_update(const H& sensor, Gain<H>& g) const {
-    using SMat = typename Gain<H>::SMat;
-    const SMat R = measurement_noise(sensor, x_);
-    if constexpr (has_identity_jacobian_v<H> && DimOf<typename H::Measurement> == Dim) {
-      g.S = P_ + R;
-      if (!g.S_solver.compute(g.S)) return FilterStatus::kNotPositiveDefinite;
-      g.K = g.S_solver.right_solve(P_);  // K = P S^-1
-      const Covariance I_K = Covariance::Identity() - g.K;
-      g.P_post = I_K * P_ * I_K.transpose() + g.K * R * g.K.transpose();
+  static constexpr bool kSelects =
+      (has_identity_jacobian_v<H> && DimOf<typename H::Measurement> == Dim) || has_selection_v<H>;
+  template <class H>
+  static constexpr std::array<int, std::size_t(DimOf<typename H::Measurement>)> selection() {
+    if constexpr (has_selection_v<H>) {
+      return H::kSelection;
     } else {
-      const MeasurementJacobianOf<H> J = sensor.jacobian(x_);
-      const Eigen::Matrix<Scalar, DimOf<typename H::Measurement>, Dim> JP = J * P_;
-      g.S = JP * J.transpose() + R;
-      if (!g.S_solver.compute(g.S)) return FilterStatus::kNotPositiveDefinite;
-      g.K = g.S_solver.right_solve(
-          Eigen::Matrix<Scalar, Dim, DimOf<typename H::Measurement>>(JP.transpose()));  // P J^T S^-1
-      const Covariance I_KH = Covariance::Identity() - g.K * J;
-      g.P_post = I_KH * P_ * I_KH.transpose() + g.K * R * g.K.transpose();
+      std::array<int, std::size_t(DimOf<typename H::Measurement>)> s{};
+      for (std::size_t i = 0; i < s.size(); ++i) s[i] = int(i);
+      return s;
     }
-    if (!g.P_post.allFinite()) return FilterStatus::kNonFinite;
-    g.P_post = symmetrised(g.P_post);
+  }
+
+  template <class H>
+  [[gnu::always_inline]] FilterStatus covariance_update(const H& sensor, Gain<H>& g) const {
+    constexpr int M = DimOf<typename H::Measurement>;
+    using SMat = typename Gain<H>::SMat;
+    using HP = Eigen::Matrix<Scalar, M, Dim>;
+    using Nm = Eigen::Matrix<Scalar, Dim, M>;
+    const SMat R = measurement_noise(sensor, x_);
+    HP JP;  // H P, which is (P H^T)^T for the symmetric P
+    [[maybe_unused]] MeasurementJacobianOf<H> J;
+    if constexpr (kSelects<H>) {
+      constexpr std::array<int, std::size_t(M)> sel = selection<H>();
+      for (int a = 0; a < M; ++a) {
+        JP.row(a) = P_.row(sel[std::size_t(a)]);
+        for (int b = 0; b < M; ++b)
+          g.S(a, b) = P_(sel[std::size_t(a)], sel[std::size_t(b)]) + R(a, b);
+      }
+    } else {
+      J = sensor.jacobian(x_);
+      JP = J * P_;
+      g.S = JP * J.transpose() + R;
+    }
+    if (!g.S_solver.compute(g.S)) return FilterStatus::kNotPositiveDefinite;
+    g.K = g.S_solver.right_solve(Nm(JP.transpose()));  // P H^T S^-1
+    const Covariance A = P_ - g.K.lazyProduct(JP);      // (I - K H) P
+    if constexpr (Options::kCovarianceUpdate == CovarianceUpdate::kStandard) {
+      g.P_post = A;
+      mirror_lower(g.P_post);
+    } else {
+      // Joseph: A (I - K H)^T + K R K^T = A + (K R - A H^T) K^T, one triangle.
+      Nm AHt;
+      if constexpr (kSelects<H>) {
+        constexpr std::array<int, std::size_t(M)> sel = selection<H>();
+        for (int a = 0; a < M; ++a) AHt.col(a) = A.col(sel[std::size_t(a)]);
+      } else {
+        AHt = A * J.transpose();
+      }
+      const Nm C = g.K.lazyProduct(R) - AHt;
+      for (int j = 0; j < Dim; ++j) {
+        for (int i = j; i < Dim; ++i) {
+          Scalar v = A(i, j);
+          for (int k = 0; k < M; ++k) v += C(i, k) * g.K(j, k);
+          g.P_post(i, j) = v;
+          g.P_post(j, i) = v;
+        }
+      }
+    }
     // The Joseph form is PSD in exact arithmetic; with a singular or badly
     // scaled prior, rounding can still give a negative variance. Such a
-    // result is refused (core/gaussian.hpp's criterion), never stored.
-    if (!is_positive_semidefinite(g.P_post)) return FilterStatus::kNotPositiveDefinite;
+    // result is refused (core/gaussian.hpp's criterion, which also refuses
+    // NaN and Inf), never stored.
+    if (!is_positive_semidefinite(g.P_post))
+      return g.P_post.allFinite() ? FilterStatus::kNotPositiveDefinite : FilterStatus::kNonFinite;
     return FilterStatus::kApplied;
   }
 
@@ -493,22 +686,69 @@ class Ekf {
   }
 
   template <class H, class Gate>
-  UpdateResult<H> apply_update(const H& sensor, const typename H::Measurement& z, Scalar nis_gate,
+  [[gnu::always_inline]] UpdateResult<H> apply_update(const H& sensor, const typename H::Measurement& z, Scalar nis_gate,
                                const Gate& gate, const Gain<H>& g) {
     using Z = typename H::Measurement;
     UpdateResult<H> out;
     out.S = g.S;
     out.innovation = minus(z, static_cast<Z>(sensor.predict(x_)));
-    if (!out.innovation.allFinite()) return out;  // kNonFinite
-    out.nis = g.S_solver.nis(out.innovation);
-    if (!(out.nis <= nis_gate)) return fail(out, FilterStatus::kGated);
+    if (!finite(out.innovation)) return out;  // kNonFinite
+    if (needs_nis<H, Gate>(nis_gate)) {
+      out.nis = g.S_solver.nis(out.innovation);
+      if (!(out.nis <= nis_gate)) return fail(out, FilterStatus::kGated);
+    }
     if (!gate_accepts<H>(gate, out)) return fail(out, FilterStatus::kGated);
     const StateType x_new = plus(x_, TangentOf<StateType>(g.K * out.innovation));
-    if (!minus(x_new, x_).allFinite()) return fail(out, FilterStatus::kNonFinite);
+    if (!finite(minus(x_new, x_))) return fail(out, FilterStatus::kNonFinite);
     x_ = x_new;
     P_ = g.P_post;
     out.status = FilterStatus::kApplied;
     return out;
+  }
+
+  /// Whether an update computes its NIS (Options::kNis).
+  template <class H, class Gate>
+  static bool needs_nis(Scalar nis_gate) noexcept {
+    if constexpr (Options::kNis == NisPolicy::kAlways) {
+      return true;
+    } else {
+      using Innov = typename UpdateResult<H>::Innovation;
+      using InnovCov = typename UpdateResult<H>::InnovationCovariance;
+      if constexpr (std::is_arithmetic_v<Gate> ||
+                    std::is_invocable_r_v<bool, const Gate&, const Innov&, const InnovCov&, Scalar>) {
+        return true;
+      } else {
+        return nis_gate < std::numeric_limits<Scalar>::infinity();
+      }
+    }
+  }
+
+  /// \f$ F P F^\top + Q \f$, lower triangle only (mirror_lower() completes it).
+  [[gnu::always_inline]] Covariance sandwich(const Covariance& F, const Covariance& Q) const {
+    const Covariance FP = F.lazyProduct(P_);
+    Covariance out;
+    for (int j = 0; j < Dim; ++j)
+      for (int i = j; i < Dim; ++i) out(i, j) = Q(i, j) + FP.row(i).dot(F.row(j));
+    return out;
+  }
+  /// Every entry equal (==) to the other's.
+  [[gnu::always_inline]] static bool same_values(const Covariance& a, const Covariance& b) noexcept {
+    for (int i = 0; i < Dim * Dim; ++i)
+      if (a.data()[i] != b.data()[i]) return false;
+    return true;
+  }
+  /// True when every entry is finite, in one branch-free pass: v - v is 0
+  /// for a finite entry and NaN for NaN or Inf.
+  template <int N>
+  [[gnu::always_inline]] static bool finite(const Eigen::Matrix<Scalar, N, 1>& v) noexcept {
+    Scalar s = Scalar(0);
+    for (int i = 0; i < N; ++i) s += v(i) - v(i);
+    return s == Scalar(0);
+  }
+  /// Copies the lower triangle onto the upper one (exactly symmetric; no arithmetic).
+  [[gnu::always_inline]] static void mirror_lower(Covariance& P) noexcept {
+    for (int j = 0; j < Dim; ++j)
+      for (int i = j + 1; i < Dim; ++i) P(j, i) = P(i, j);
   }
 
   template <class R>
@@ -516,12 +756,6 @@ class Ekf {
     r.status = s;
     return r;
   }
-  /// (P + P^T) / 2, as P/2 + P^T/2 so that it cannot overflow where P is
-  /// finite (halving is exact, so the result is bit-identical otherwise).
-  static Covariance symmetrised(const Covariance& P) {
-    return Scalar(0.5) * P + Scalar(0.5) * P.transpose();
-  }
-
   Motion motion_;
   std::tuple<Sensors...> sensors_;
   std::tuple<GainMemo<Sensors>...> memos_;
@@ -531,5 +765,10 @@ class Ekf {
   Covariance F_ = Covariance::Identity();
   bool initialised_ = false;
 };
+
+/// The EKF with the default options (EkfOptions): Joseph form, NIS always,
+/// Jacobians recorded, gain memo on. See BasicEkf.
+template <class Motion, class... Sensors>
+using Ekf = BasicEkf<EkfOptions, Motion, Sensors...>;
 
 }  // namespace posefuse

@@ -57,6 +57,16 @@ class ConstantVelocity2 {
     Q(2, 2) = Q(3, 3) = c;
     return Q;
   }
+  /// \f$ F P F^\top \f$ for F = [I, dt I; 0, I] without the products:
+  /// rows, then columns, of the position block gain dt times the velocity
+  /// ones (see HasPropagate).
+  [[nodiscard]] Matrix propagate(const Matrix& P, const State&, const Control&, T dt) const {
+    Matrix B = P;
+    B.template topRows<2>() += dt * P.template bottomRows<2>();  // F P
+    Matrix out = B;
+    out.template leftCols<2>() += dt * B.template rightCols<2>();  // (F P) F^T
+    return out;
+  }
   [[nodiscard]] T q() const noexcept { return q_; }
 
  private:

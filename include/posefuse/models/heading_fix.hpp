@@ -7,6 +7,7 @@
 /// the heading difference wrapped to [-π, π), and \f$ H = [0, 0, 1] \f$.
 
 #include <Eigen/Core>
+#include <array>
 #include <cmath>
 #include <concepts>
 #include <posefuse/core/concepts.hpp>
@@ -23,6 +24,8 @@ class HeadingFix {
   using State = PlanarPose<T>;  ///< pose in the world frame
   using Measurement = SO2<T>;   ///< heading in the world frame
   static constexpr bool kTimeInvariant = true;  ///< H and R depend on neither x nor time
+  /// H = [0, 0, 1] selects the heading (see has_selection_v).
+  static constexpr std::array<int, 1> kSelection = {2};
 
   /// @param[in] sigma_rad 1-σ heading noise (rad), finite and > 0
   /// @throws posefuse::invalid_argument otherwise

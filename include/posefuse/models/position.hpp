@@ -7,6 +7,8 @@
 /// **Q** \f$ = \mathrm{diag}(\sigma_{x,orb}^2, \sigma_{y,orb}^2) \f$.
 
 #include <Eigen/Core>
+#include <array>
+#include <cstddef>
 #include <concepts>
 #include <posefuse/core/concepts.hpp>
 #include <posefuse/core/gaussian.hpp>
@@ -24,6 +26,12 @@ class PositionFix {
   using Noise = Eigen::Matrix<T, N, N>;
   static constexpr bool kIdentityJacobian = (N == StateDim);  ///< H = I when square
   static constexpr bool kTimeInvariant = true;  ///< H and Q depend on neither x nor time
+  /// H selects state components 0 .. N-1 (see has_selection_v).
+  static constexpr std::array<int, std::size_t(N)> kSelection = [] {
+    std::array<int, std::size_t(N)> s{};
+    for (std::size_t i = 0; i < s.size(); ++i) s[i] = int(i);
+    return s;
+  }();
 
   /// @param[in] Q measurement noise (m^2), the seed's Q
   /// @throws posefuse::invalid_argument unless Q is symmetric positive definite

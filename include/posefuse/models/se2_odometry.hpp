@@ -128,6 +128,19 @@ class Se2Odometry {
     State state;       ///< \f$ x \oplus \delta \f$
     Matrix3 jacobian;  ///< F
     Matrix3 noise;     ///< Q
+    /// \f$ F P F^\top \f$ for F = [I, c; 0, 1] (c its top-right column):
+    /// rows, then columns, 0 and 1 gain c times row / column 2 (see
+    /// HasLinearizePropagate).
+    [[nodiscard]] Matrix3 propagate(const Matrix3& P) const noexcept {
+      const T c0 = jacobian(0, 2), c1 = jacobian(1, 2);
+      Matrix3 B = P;
+      B.row(0) += c0 * P.row(2);
+      B.row(1) += c1 * P.row(2);
+      Matrix3 out = B;
+      out.col(0) += c0 * B.col(2);
+      out.col(1) += c1 * B.col(2);
+      return out;
+    }
   };
   [[nodiscard]] Linearization linearize(const State& x, const Control& d, T /*dt_s*/) const noexcept {
     const SE2<T> g = as_se2(x);

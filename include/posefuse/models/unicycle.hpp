@@ -129,6 +129,37 @@ struct Unicycle {
     const Eigen::Matrix<T, 3, 3> Q = (dt_s * dt_s) * (Ju * control_cov * Ju.transpose());
     return T(0.5) * (Q + Q.transpose());
   }
+
+  /// predict(), jacobian() and noise() from one integration of the step
+  /// (see HasLinearize): the same values bit for bit, the arc computed once
+  /// instead of three times.
+  struct Linearization {
+    State state;                      ///< \f$ f(x, u, \Delta t) \f$
+    Eigen::Matrix<T, 3, 3> jacobian;  ///< \f$ J_{f,x} = [1, 0, a; 0, 1, b; 0, 0, 1] \f$
+    Eigen::Matrix<T, 3, 3> noise;     ///< process noise, as noise()
+    /// \f$ J_{f,x} P J_{f,x}^\top \f$ from the two non-trivial entries of the
+    /// Jacobian (rows, then columns, 0 and 1 gain a, b times row / column 2;
+    /// see HasLinearizePropagate).
+    [[nodiscard]] Eigen::Matrix<T, 3, 3> propagate(const Eigen::Matrix<T, 3, 3>& P) const noexcept {
+      const T a = jacobian(0, 2), b = jacobian(1, 2);
+      Eigen::Matrix<T, 3, 3> B = P;
+      B.row(0) += a * P.row(2);
+      B.row(1) += b * P.row(2);
+      Eigen::Matrix<T, 3, 3> out = B;
+      out.col(0) += a * B.col(2);
+      out.col(1) += b * B.col(2);
+      return out;
+    }
+  };
+  /// The step, its Jacobian and its noise at once.
+  [[nodiscard]] Linearization linearize(const State& x, const Control& u, T dt_s) const noexcept {
+    Linearization out;
+    Eigen::Matrix<T, 3, 2> Ju;
+    out.state = unicycle_step(x, u(0) * dt_s, u(1) * dt_s, method, &out.jacobian, &Ju);
+    const Eigen::Matrix<T, 3, 3> Q = (dt_s * dt_s) * (Ju * control_cov * Ju.transpose());
+    out.noise = T(0.5) * (Q + Q.transpose());
+    return out;
+  }
 };
 
 }  // namespace posefuse

@@ -304,6 +304,56 @@ template <class Derived>
   return combine(n, r);
 }
 
+namespace detail {
+/// A fixed, well-conditioned SPD test covariance with distinct entries,
+/// \f$ A A^\top + I \f$ with \f$ A_{ij} = \sin(7i + 3j + 1) \f$, for checks of
+/// covariance propagation.
+template <class M>
+M test_covariance() {
+  M A;
+  for (int i = 0; i < A.rows(); ++i)
+    for (int j = 0; j < A.cols(); ++j)
+      A(i, j) = typename M::Scalar(std::sin(7.0 * i + 3.0 * j + 1.0));
+  return A * A.transpose() + M::Identity();
+}
+
+/// Largest |a - b| / (1 + max|b|) of two matrices.
+template <class DA, class DB>
+double matrix_error(const Eigen::MatrixBase<DA>& a, const Eigen::MatrixBase<DB>& b) {
+  if (!a.allFinite() || !b.allFinite()) return std::numeric_limits<double>::infinity();
+  return double((a - b).cwiseAbs().maxCoeff()) / (1.0 + double(b.cwiseAbs().maxCoeff()));
+}
+
+/// Checks declared Jacobian structure against the Jacobian J a model
+/// returned: `kIdentityJacobian` (J must be I) and, for measurement models,
+/// `kSelection` (row k of J must be the unit row of state index s_k).
+template <class Model, class Derived>
+void check_declared_structure(const Eigen::MatrixBase<Derived>& J, double tol,
+                              std::vector<CheckResult>& r) {
+  using Mat = typename Derived::PlainObject;
+  if constexpr (has_identity_jacobian_v<Model>) {
+    Mat I = Mat::Zero();
+    for (int i = 0; i < std::min<int>(int(I.rows()), int(I.cols())); ++i) I(i, i) = 1;
+    r.push_back(value_check("declared kIdentityJacobian: jacobian == I", matrix_error(J, I), tol));
+  }
+  if constexpr (requires { Model::kSelection; }) {
+    Mat H = Mat::Zero();
+    bool in_range = int(Model::kSelection.size()) == int(H.rows());
+    for (std::size_t k = 0; in_range && k < Model::kSelection.size(); ++k) {
+      const int c = Model::kSelection[k];
+      if (c < 0 || c >= int(H.cols())) {
+        in_range = false;
+      } else {
+        H(int(k), c) = 1;
+      }
+    }
+    r.push_back(value_check("declared kSelection: jacobian == selection rows",
+                            in_range ? matrix_error(J, H) : std::numeric_limits<double>::infinity(),
+                            tol));
+  }
+}
+}  // namespace detail
+
 /// Checks a posefuse::MotionModel at (x, u, dt): `jacobian(x, u, dt)` against
 /// the numeric \f$ \partial f / \partial x \f$ of `predict` through the
 /// state's plus / minus, the prediction finite, and `noise(x, u, dt)`
@@ -327,6 +377,19 @@ template <MotionModel M>
       step));
   const CovarianceOf<S> Q = model.noise(x, u, dt_s);
   r.push_back(check_covariance("noise (Q)", Q, tol));
+  detail::check_declared_structure<M>(F, tol, r);
+  const CovarianceOf<S> P = detail::test_covariance<CovarianceOf<S>>();
+  const CovarianceOf<S> FPFt = F * P * F.transpose();
+  if constexpr (HasPropagate<M>) {
+    r.push_back(detail::value_check("propagate(P) == F P F^T",
+                                    detail::matrix_error(model.propagate(P, x, u, dt_s), FPFt),
+                                    tol));
+  }
+  if constexpr (HasLinearizePropagate<M>) {
+    const auto lin = model.linearize(x, u, dt_s);
+    r.push_back(detail::value_check("linearize().propagate(P) == F P F^T",
+                                    detail::matrix_error(lin.propagate(P), FPFt), tol));
+  }
   if constexpr (HasLinearize<M>) {
     // The one-call form must agree with the three calls, and its Jacobian
     // is checked on its own: a wrong entry there alone must fail.
@@ -370,6 +433,7 @@ requires requires {
   const MeasurementJacobianOf<H> J = model.jacobian(x);
   r.push_back(check_jacobian(
       "jacobian (J_h_x)", [&](const S& s) -> Z { return model.predict(s); }, x, J, tol, step));
+  detail::check_declared_structure<H>(J, tol, r);
   if constexpr (requires(const H& h, const S& s) { h.noise(s); }) {
     const CovarianceOf<Z> R = model.noise(x);
     r.push_back(check_covariance("noise(x) (R)", R, tol));
