@@ -73,7 +73,7 @@ NumberedRows<double> read_stamp_rows(const std::filesystem::path& file,
   std::string line;
   std::size_t row = 0;
   std::size_t previous_line = 0;
-  for (; reader.next(line);) {
+  while (reader.next(line)) {
     if (is_blank_or_comment(line)) continue;
     const double t = parse_row(line, 1, "one timestamp in seconds", file, reader.line_no())[0];
     if (all_lines != nullptr) all_lines->push_back(reader.line_no());
