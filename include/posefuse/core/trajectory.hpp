@@ -20,6 +20,7 @@
 #include <vector>
 
 #include <posefuse/core/error.hpp>
+#include <posefuse/core/lazy.hpp>
 #include <posefuse/core/time.hpp>
 #include <posefuse/core/plane.hpp>
 
@@ -48,16 +49,18 @@ struct Trajectory {
   }
 
   /// The body positions \f$ p_k = t(T_{world,body,k}) \f$ in the world frame (m).
+  template <class Lazy = void>  // compiled only where called (compile cost, core/lazy.hpp)
   [[nodiscard]] std::vector<Eigen::Vector3d> positions() const {
     std::vector<Eigen::Vector3d> p;
     p.reserve(poses.size());
-    for (const Eigen::Isometry3d& T : poses) p.emplace_back(T.translation());
+    for (const detail::dependent_t<Eigen::Isometry3d, Lazy>& T : poses) p.emplace_back(T.translation());
     return p;
   }
 
   /// Checks the invariants: as many stamps as poses, every stamp and pose
   /// entry finite, and strictly increasing stamps.
   /// @throws posefuse::invalid_argument naming the first offending index
+  template <class Lazy = void>  // compiled only where called (compile cost, core/lazy.hpp)
   void validate() const {
     if (t_s.size() != poses.size()) {
       throw invalid_argument("trajectory has " + std::to_string(t_s.size()) + " stamps but " +
@@ -67,7 +70,8 @@ struct Trajectory {
       if (!std::isfinite(t_s[k])) {
         throw invalid_argument("trajectory stamp " + std::to_string(k) + " is not finite");
       }
-      if (!poses[k].matrix().allFinite()) {
+      const detail::dependent_t<Eigen::Isometry3d, Lazy>& T = poses[k];
+      if (!T.matrix().allFinite()) {
         throw invalid_argument("trajectory pose " + std::to_string(k) + " is not finite");
       }
       if (k > 0 && !(t_s[k] > t_s[k - 1])) {
@@ -174,15 +178,18 @@ struct PlanarTrajectory {
   /// Checks the invariants: as many stamps as poses, every stamp and pose
   /// entry finite, and strictly increasing stamps.
   /// @throws posefuse::invalid_argument naming the first offending index
-  void validate() const { validate_impl(true); }
+  template <class Lazy = void>
+  void validate() const { validate_impl<Lazy>(true); }
 
   /// Checks the weaker invariants that a *reported* track (what an estimator
   /// output over time) needs: as validate(), but equal consecutive stamps are
   /// allowed (two poses reported at one time; the later one wins).
   /// @throws posefuse::invalid_argument naming the first offending index
-  void validate_time_order() const { validate_impl(false); }
+  template <class Lazy = void>
+  void validate_time_order() const { validate_impl<Lazy>(false); }
 
  private:
+  template <class Lazy = void>  // compiled only where called (compile cost, core/lazy.hpp)
   void validate_impl(bool strict) const {
     if (t_s.size() != poses.size()) {
       throw invalid_argument("planar trajectory has " + std::to_string(t_s.size()) +
@@ -192,7 +199,8 @@ struct PlanarTrajectory {
       if (!std::isfinite(t_s[k])) {
         throw invalid_argument("planar trajectory stamp " + std::to_string(k) + " is not finite");
       }
-      if (!poses[k].allFinite()) {
+      const detail::dependent_t<Eigen::Vector3d, Lazy>& x = poses[k];
+      if (!x.allFinite()) {
         throw invalid_argument("planar trajectory pose " + std::to_string(k) + " is not finite");
       }
       if (k > 0 && (strict ? !(t_s[k] > t_s[k - 1]) : t_s[k] < t_s[k - 1])) {

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include <posefuse/core/error.hpp>
+#include <posefuse/core/lazy.hpp>
 #include <posefuse/core/trajectory.hpp>
 
 namespace posefuse {
@@ -64,8 +65,10 @@ struct AlignmentResult {
   double scale = 1.0;                                      ///< \f$ c \f$ (1 unless Sim(3))
 
   /// Maps a point: \f$ c R x + t \f$.
+  template <class Lazy = void>  // compiled only where called (compile cost, core/lazy.hpp)
   [[nodiscard]] Eigen::Vector3d apply(const Eigen::Vector3d& x) const {
-    return scale * (rotation * x) + translation;
+    const detail::dependent_t<Eigen::Matrix3d, Lazy>& R = rotation;
+    return scale * (R * x) + translation;
   }
 };
 

@@ -26,6 +26,7 @@
 #include <iterator>
 #include <numbers>
 #include <posefuse/core/error.hpp>
+#include <posefuse/core/lazy.hpp>
 #include <ranges>
 #include <string>
 #include <type_traits>
@@ -53,9 +54,10 @@ struct MagnetometerCalibration {
   /// The calibrated field \f$ S (m - h) \f$.
   /// @param[in] m raw reading, µT (sensor frame)
   /// @return calibrated reading, µT (sensor frame)
-  template <class Lazy = void>  // compiled only where called (compile cost)
+  template <class Lazy = void>  // compiled only where called (compile cost, core/lazy.hpp)
   [[nodiscard]] Eigen::Vector3d apply(const Eigen::Vector3d& m) const {
-    return soft_iron * (m - hard_iron);
+    const detail::dependent_t<Eigen::Matrix3d, Lazy>& S = soft_iron;
+    return S * (m - hard_iron);
   }
 };
 
@@ -82,24 +84,28 @@ template <class Readings>
   requires MagnetometerReadings<const Readings&, 3>
 [[nodiscard]] MagnetometerCalibration fit_ellipsoid(const Readings& samples,
                                                     double field_norm_uT = 0.0) {
-  using Vec9 = Eigen::Matrix<double, 9, 1>;
-  using Mat9 = Eigen::Matrix<double, 9, 9>;
+  // Dependent types: nothing below is compiled unless the fit is called.
+  using T = detail::dependent_t<double, Readings>;
+  using Vec9 = Eigen::Matrix<T, 9, 1>;
+  using Mat9 = Eigen::Matrix<T, 9, 9>;
+  using Vec3 = Eigen::Matrix<T, 3, 1>;
+  using Mat3 = Eigen::Matrix<T, 3, 3>;
   const auto count = std::size_t(std::ranges::distance(samples));
   if (count < 9)
     throw invalid_argument("posefuse: fit_ellipsoid needs at least 9 samples, got " +
                            std::to_string(count));
   if (!(std::isfinite(field_norm_uT) && field_norm_uT >= 0.0))
     throw invalid_argument("posefuse: fit_ellipsoid field_norm_uT must be finite and >= 0");
-  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  Vec3 c = Vec3::Zero();
   for (const auto& r : samples) {
-    const Eigen::Vector3d& m = r;
+    const Vec3& m = r;
     if (!m.allFinite()) throw invalid_argument("posefuse: fit_ellipsoid got a non-finite sample");
     c += m;
   }
   c /= double(count);
   double s2 = 0.0;
   for (const auto& r : samples) {
-    const Eigen::Vector3d& m = r;
+    const Vec3& m = r;
     s2 += (m - c).squaredNorm();
   }
   const double s = std::sqrt(s2 / double(count));
@@ -108,15 +114,15 @@ template <class Readings>
   Mat9 N = Mat9::Zero();
   Vec9 rhs = Vec9::Zero();
   for (const auto& r : samples) {
-    const Eigen::Vector3d& m = r;
-    const Eigen::Vector3d p = (m - c) / s;
+    const Vec3& m = r;
+    const Vec3 p = (m - c) / s;
     Vec9 v;
     v << p.x() * p.x(), p.y() * p.y(), p.z() * p.z(), 2 * p.x() * p.y(), 2 * p.x() * p.z(),
         2 * p.y() * p.z(), 2 * p.x(), 2 * p.y(), 2 * p.z();
-    N.selfadjointView<Eigen::Lower>().rankUpdate(v);
+    N.template selfadjointView<Eigen::Lower>().rankUpdate(v);
     rhs += v;
   }
-  N.triangularView<Eigen::StrictlyUpper>() = N.transpose();
+  N.template triangularView<Eigen::StrictlyUpper>() = N.transpose();
   const Eigen::SelfAdjointEigenSolver<Mat9> es(N);
   const double lmax = es.eigenvalues().maxCoeff();
   if (es.info() != Eigen::Success || !(es.eigenvalues().minCoeff() > 1e-10 * lmax))
@@ -126,19 +132,19 @@ template <class Readings>
   const Vec9 beta = es.eigenvectors() *
                     (es.eigenvalues().cwiseInverse().asDiagonal() *
                      (es.eigenvectors().transpose() * rhs));
-  Eigen::Matrix3d A;
+  Mat3 A;
   A << beta(0), beta(3), beta(4), beta(3), beta(1), beta(5), beta(4), beta(5), beta(2);
-  const Eigen::Vector3d u(beta(6), beta(7), beta(8));
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> ea(A);
+  const Vec3 u(beta(6), beta(7), beta(8));
+  const Eigen::SelfAdjointEigenSolver<Mat3> ea(A);
   if (!(ea.eigenvalues().minCoeff() > 0.0))
     throw invalid_argument("posefuse: fit_ellipsoid: the fitted quadric is not an ellipsoid");
-  const Eigen::Vector3d h = -(ea.eigenvectors() * (ea.eigenvalues().cwiseInverse().asDiagonal() *
+  const Vec3 h = -(ea.eigenvectors() * (ea.eigenvalues().cwiseInverse().asDiagonal() *
                                                    (ea.eigenvectors().transpose() * u)));
   const double g = 1.0 + h.dot(A * h);
   if (!(g > 0.0))
     throw invalid_argument("posefuse: fit_ellipsoid: the fitted quadric is not an ellipsoid");
   // Back to raw units: Q_raw = A / (g s^2); S = k Q_raw^{1/2}.
-  const Eigen::Vector3d q = ea.eigenvalues() / (g * s * s);
+  const Vec3 q = ea.eigenvalues() / (g * s * s);
   const double k = field_norm_uT > 0.0 ? field_norm_uT : std::cbrt(1.0 / std::sqrt(q.prod()));
   MagnetometerCalibration cal;
   cal.hard_iron = c + s * h;
@@ -232,6 +238,12 @@ template <class Readings>
   requires MagnetometerReadings<const Readings&, 2>
 [[nodiscard]] HorizontalEllipseFit fit_horizontal_ellipse(
     const Readings& readings, const HorizontalEllipseFitOptions& options = {}) {
+  // Dependent types: nothing below is compiled unless the fit is called.
+  using T = detail::dependent_t<double, Readings>;
+  using Vec2 = Eigen::Matrix<T, 2, 1>;
+  using Mat2 = Eigen::Matrix<T, 2, 2>;
+  using Vec5 = Eigen::Matrix<T, 5, 1>;
+  using Mat5 = Eigen::Matrix<T, 5, 5>;
   HorizontalEllipseFit out;
   out.readings = std::size_t(std::ranges::distance(readings));
   const auto fail = [&out](EllipseFitStatus why) {
@@ -242,53 +254,53 @@ template <class Readings>
   if (out.readings < options.min_readings || out.readings == 0)
     return fail(EllipseFitStatus::kTooFewReadings);
   const double n = double(out.readings);
-  Eigen::Vector2d c = Eigen::Vector2d::Zero();
+  Vec2 c = Vec2::Zero();
   for (const auto& r : readings) {
-    const Eigen::Vector2d& m = r;
+    const Vec2& m = r;
     if (!m.allFinite()) return fail(EllipseFitStatus::kNonFinite);
     c += m;
   }
   c /= n;
   double s = 0;
   for (const auto& r : readings) {
-    const Eigen::Vector2d& m = r;
+    const Vec2& m = r;
     s += (m - c).squaredNorm();
   }
   s = std::sqrt(s / n);
   if (!(s > 0)) return fail(EllipseFitStatus::kConstantReadings);
-  Eigen::Matrix<double, 5, 5> N = Eigen::Matrix<double, 5, 5>::Zero();
-  Eigen::Matrix<double, 5, 1> rhs = Eigen::Matrix<double, 5, 1>::Zero();
+  Mat5 N = Mat5::Zero();
+  Vec5 rhs = Vec5::Zero();
   for (const auto& r : readings) {
-    const Eigen::Vector2d& m = r;
-    const Eigen::Vector2d p = (m - c) / s;
-    const Eigen::Matrix<double, 5, 1> v(p.x() * p.x(), p.x() * p.y(), p.y() * p.y(), p.x(), p.y());
+    const Vec2& m = r;
+    const Vec2 p = (m - c) / s;
+    const Vec5 v(p.x() * p.x(), p.x() * p.y(), p.y() * p.y(), p.x(), p.y());
     N += v * v.transpose();
     rhs += v;
   }
-  const Eigen::Matrix<double, 5, 1> b = N.ldlt().solve(rhs);
-  Eigen::Matrix2d M;
+  const Vec5 b = N.ldlt().solve(rhs);
+  Mat2 M;
   M << b(0), b(1) / 2, b(1) / 2, b(2);
   const double det = M(0, 0) * M(1, 1) - M(0, 1) * M(1, 0);
-  const Eigen::Vector2d ctr =
-      -0.5 * Eigen::Vector2d(M(1, 1) * b(3) - M(0, 1) * b(4), M(0, 0) * b(4) - M(1, 0) * b(3)) / det;
-  const Eigen::Matrix2d Q = M / (1.0 + ctr.dot(M * ctr));
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es;
+  const Vec2 ctr =
+      -0.5 * Vec2(M(1, 1) * b(3) - M(0, 1) * b(4), M(0, 0) * b(4) - M(1, 0) * b(3)) / det;
+  const Mat2 Q = M / (1.0 + ctr.dot(M * ctr));
+  Eigen::SelfAdjointEigenSolver<Mat2> es;
   es.computeDirect(Q);
-  const Eigen::Vector2d ev = es.eigenvalues();
+  const Vec2 ev = es.eigenvalues();
   if (!b.allFinite() || !(ev.minCoeff() > 0) ||
       !(ev.maxCoeff() / ev.minCoeff() <= options.max_eigenvalue_ratio))
     return fail(EllipseFitStatus::kNotAnEllipse);
   std::array<bool, 36> seen{};  // 10° bins of the reading's direction about the centre
   for (const auto& r : readings) {
-    const Eigen::Vector2d& m = r;
-    const Eigen::Vector2d p = (m - c) / s - ctr;
+    const Vec2& m = r;
+    const Vec2 p = (m - c) / s - ctr;
     const double a = std::atan2(p.y(), p.x()) + std::numbers::pi;
     seen[std::size_t(std::min(35.0, a / (2 * std::numbers::pi) * 36))] = true;
   }
   out.coverage_deg = 10.0 * double(std::count(seen.begin(), seen.end(), true));
   if (out.coverage_deg < options.min_coverage_deg) return fail(EllipseFitStatus::kTooLittleTurning);
   const double k = 1.0 / std::sqrt(std::sqrt(ev.prod()));  // keep the geometric-mean radius
-  const Eigen::Matrix2d S = k * es.eigenvectors() * ev.cwiseSqrt().asDiagonal() *
+  const Mat2 S = k * es.eigenvectors() * ev.cwiseSqrt().asDiagonal() *
                             es.eigenvectors().transpose();
   out.calibration.hard_iron << c + s * ctr, 0.0;
   out.calibration.soft_iron.setIdentity();
