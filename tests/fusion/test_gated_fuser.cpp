@@ -1,6 +1,7 @@
 // The sound fuser: information weighting, gates, angle awareness, re-anchoring.
 #include <catch2/catch.hpp>
 
+#include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <cmath>
 #include <numbers>
@@ -410,8 +411,11 @@ TEST_CASE("GatedFuser: its prediction and SLAM update are Ekf steps of the plana
     if (k % 3 == 0) {
       const Pose z{o.x + 0.01, o.y - 0.02, posefuse::wrap_angle(o.theta + 0.005)};
       REQUIRE(f.update_slam(z, false) == FuserStatus::kFused);
-      const Pose zw = posefuse::as_planar_pose(posefuse::as_se2(f.map_in_world()) *
-                                               posefuse::as_se2(z));
+      // T_wm (+) z as the fuser forms it: position through the map frame's
+      // rotation, heading as the wrapped sum of the two headings.
+      const Pose a = f.map_in_world();
+      const Eigen::Vector2d pw = posefuse::as_se2(a).act(z.position());
+      const Pose zw{pw.x(), pw.y(), posefuse::wrap_angle(a.theta + z.theta)};
       REQUIRE(ekf.update_with(slam, zw));
       REQUIRE(f.pose().x == ekf.state().x);
       REQUIRE(f.pose().theta == ekf.state().theta);

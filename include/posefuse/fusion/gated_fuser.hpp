@@ -60,7 +60,6 @@
 /// metres let it drift along that unobservable direction — the classic
 /// EKF-SLAM inconsistency — and it did worse on the corridor.)
 
-#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <array>
 #include <cmath>
@@ -343,7 +342,10 @@ class GatedFuser {
       return FuserStatus::kNonFinite;
     if (new_map_frame || anchor_ == AnchorState::kNone) start_anchoring();
     if (anchor_ == AnchorState::kCollecting) return collect(z);
-    const Pose zw = as_planar_pose(a_g_ * as_se2(z));  // SLAM pose in the world
+    // The SLAM pose in the world, T_wm (+) z: the heading as a wrapped sum,
+    // so no trigonometry of z is needed.
+    const typename SE2<T>::Point pw = a_g_.act(z.position());
+    const Pose zw{pw.x(), pw.y(), wrap_angle(a_.theta + z.theta)};
     FuserGate failed = FuserGate::kNone;
     const auto gates = [this, &failed](const Vec3& r, const Mat3& S, T nis) {
       failed = which_gate_fails(r, S, nis);
@@ -443,9 +445,12 @@ class GatedFuser {
   /// The first of the configured gates that r fails (kNone: accepted).
   FuserGate which_gate_fails(const Vec3& r, const Mat3& S, T nis) const noexcept {
     if (p_.gate != GateMode::kMahalanobis) {
-      const Eigen::Matrix<T, 2, 1> rxy = r.template head<2>();
-      const T dxy = rxy.dot(S.template topLeftCorner<2, 2>().ldlt().solve(rxy));
-      if (!(dxy <= p_.gate_xy_chi2)) return FuserGate::kPosition;
+      // r_xy^T S_xy^-1 r_xy in closed form (S_xy = S's top-left 2x2 block,
+      // positive definite because the Ekf accepted S): adj(S_xy) / det.
+      const T det = S(0, 0) * S(1, 1) - S(0, 1) * S(1, 0);
+      const T dxy = (S(1, 1) * r(0) * r(0) - (S(0, 1) + S(1, 0)) * r(0) * r(1) +
+                     S(0, 0) * r(1) * r(1)) / det;
+      if (!(det > T(0)) || !(dxy <= p_.gate_xy_chi2)) return FuserGate::kPosition;
       if (!(r(2) * r(2) <= p_.gate_theta_chi2 * S(2, 2))) return FuserGate::kHeading;
     }
     if (p_.gate != GateMode::kSeparate && !(nis <= p_.gate_joint_chi2)) return FuserGate::kJoint;

@@ -32,11 +32,13 @@
 /// k_{\theta\theta}^2 |\theta_\delta|) \f$ with \f$ s = \|t_\delta\| \f$
 /// (random-walk growth with distance and with the angle turned), mapped to
 /// the state by \f$ J_\delta = \mathrm{diag}(R(\theta), 1) \f$ (`SE2::act`'s
-/// `J_q_p` and the angle sum): \f$ Q = J_\delta Q_\delta J_\delta^\top \f$.
+/// `J_q_p` and the angle sum): \f$ Q = J_\delta Q_\delta J_\delta^\top \f$, which
+/// is \f$ Q_\delta \f$ itself because its position block is isotropic.
 
 #include <Eigen/Core>
 #include <cmath>
 #include <concepts>
+#include <posefuse/core/angles.hpp>
 #include <posefuse/core/concepts.hpp>
 #include <posefuse/core/error.hpp>
 #include <posefuse/lie/se2.hpp>
@@ -83,8 +85,11 @@ class Se2Odometry {
   }
 
   /// \f$ x \oplus \delta \f$ (the time step is not used: δ is the motion).
+  /// The heading is summed and wrapped, \f$ \mathrm{wrap}(\theta + \theta_\delta) \f$,
+  /// rather than read back from the composed rotation (one atan2 fewer).
   [[nodiscard]] State predict(const State& x, const Control& d, T /*dt_s*/) const noexcept {
-    return as_planar_pose(as_se2(x).compose(d));
+    const typename SE2<T>::Point t = as_se2(x).act(d.translation());
+    return {t.x(), t.y(), wrap_angle(x.theta + d.angle())};
   }
 
   /// \f$ F = \partial (x \oplus \delta) / \partial x \f$ on \f$ \mathbb{R}^2 \times S^1 \f$.
@@ -109,21 +114,21 @@ class Se2Odometry {
 
   /// The diagonal of \f$ Q_\delta \f$ for increment δ (m², m², rad²).
   [[nodiscard]] Vector3 increment_variance(const Control& d) const noexcept {
-    const T s = std::hypot(d.x(), d.y()), dth = std::abs(d.angle());
-    const T kxy = n_.xy_sigma_per_sqrt_m, kts = n_.theta_sigma_per_sqrt_m,
-            ktt = n_.theta_sigma_per_sqrt_rad;
-    return {kxy * kxy * s, kxy * kxy * s, kts * kts * s + ktt * ktt * dth};
+    return variance_of(d, d.angle());
   }
 
-  /// \f$ Q = J_\delta Q_\delta J_\delta^\top \f$ (world frame, m² / rad²).
-  [[nodiscard]] Matrix3 noise(const State& x, const Control& d, T /*dt_s*/) const noexcept {
-    const Matrix3 Jd = jacobian_increment(x, d);
-    return Jd * increment_variance(d).asDiagonal() * Jd.transpose();
+  /// \f$ Q = J_\delta Q_\delta J_\delta^\top \f$ (world frame, m² / rad²). The
+  /// position block of \f$ Q_\delta \f$ is isotropic, \f$ q I_2 \f$, so
+  /// \f$ R\,(q I_2)\,R^\top = q I_2 \f$: Q equals \f$ Q_\delta \f$ and does not
+  /// depend on the state's heading.
+  [[nodiscard]] Matrix3 noise(const State& /*x*/, const Control& d, T /*dt_s*/) const noexcept {
+    return noise_of(increment_variance(d));
   }
 
   /// predict(), jacobian() and noise() at once (Ekf uses it, see
   /// HasLinearize): the same values bit for bit, with the sine and
-  /// cosine of x.theta computed once instead of three times.
+  /// cosine of x.theta computed once instead of twice and the increment's
+  /// heading (an atan2) once instead of twice.
   struct Linearization {
     State state;       ///< \f$ x \oplus \delta \f$
     Matrix3 jacobian;  ///< F
@@ -143,17 +148,14 @@ class Se2Odometry {
     }
   };
   [[nodiscard]] Linearization linearize(const State& x, const Control& d, T /*dt_s*/) const noexcept {
-    const SE2<T> g = as_se2(x);
-    Linearization out;
-    out.state = as_planar_pose(g.compose(d));
+    const T dth = d.angle();  // the increment's heading: one atan2, shared
     typename SE2<T>::ActJacobianGroup J_t_x;
-    typename SE2<T>::ActJacobianPoint J_t_d;
-    (void)g.act(d.translation(), &J_t_x, &J_t_d);
+    const typename SE2<T>::Point t = as_se2(x).act(d.translation(), &J_t_x);
+    Linearization out;
+    out.state = {t.x(), t.y(), wrap_angle(x.theta + dth)};
     out.jacobian = Matrix3::Identity();
     out.jacobian.template topRightCorner<2, 1>() = J_t_x.col(2);
-    Matrix3 Jd = Matrix3::Identity();
-    Jd.template topLeftCorner<2, 2>() = J_t_d;
-    out.noise = Jd * increment_variance(d).asDiagonal() * Jd.transpose();
+    out.noise = noise_of(variance_of(d, dth));
     return out;
   }
 
@@ -161,6 +163,18 @@ class Se2Odometry {
   [[nodiscard]] const Se2OdometryNoise<T>& noise_rates() const noexcept { return n_; }
 
  private:
+  Vector3 variance_of(const Control& d, T dth) const noexcept {
+    const T s = std::hypot(d.x(), d.y()), turned = std::abs(dth);
+    const T kxy = n_.xy_sigma_per_sqrt_m, kts = n_.theta_sigma_per_sqrt_m,
+            ktt = n_.theta_sigma_per_sqrt_rad;
+    return {kxy * kxy * s, kxy * kxy * s, kts * kts * s + ktt * ktt * turned};
+  }
+  static Matrix3 noise_of(const Vector3& v) noexcept {
+    Matrix3 Q = Matrix3::Zero();
+    Q.diagonal() = v;
+    return Q;
+  }
+
   Se2OdometryNoise<T> n_;
 };
 
