@@ -318,7 +318,7 @@ TEST_CASE("Formats: KITTI times.txt errors name the right file and line", "[io][
   SECTION("decreasing, also via read_kitti_times") {
     const auto times = dir.write("times.txt", "0.0\n0.2\n0.1\n");
     check_error(expect_io_error([&] { (void)posefuse::read_kitti_times(times); }), times, 3,
-                "timestamp 0.1 is smaller than the previous one (0.2 on line 2)");
+                "timestamp 0.1 is earlier than the previous one (0.2 on line 2)");
   }
   SECTION("two numbers on a line") {
     const auto times = dir.write("times.txt", "0.0\n0.1 0.2\n0.3\n");
@@ -358,7 +358,7 @@ TEST_CASE("Formats: TUM malformed lines report file:line and the reason", "[io][
       {"nan stamp", "nan 1 0 0 0 0 0 1\n", "non-finite value 'nan' in column 1"},
       {"equal stamp", "0.1 1 0 0 0 0 0 1\n",
        "timestamp 0.1 repeats the previous one (0.1 on line 3)"},
-      {"earlier stamp", "0.05 1 0 0 0 0 0 1\n", "timestamp 0.05 is smaller than the previous one (0.1 on line 3)"},
+      {"earlier stamp", "0.05 1 0 0 0 0 0 1\n", "timestamp 0.05 is earlier than the previous one (0.1 on line 3)"},
       {"zero quaternion", "0.2 1 0 0 0 0 0 0\n", "quaternion has zero norm"},
       {"non-unit quaternion", "0.2 1 0 0 0 0 0 2\n", "quaternion norm 2 differs from 1"},
   };
@@ -466,7 +466,7 @@ TEST_CASE("Formats: TUM repeated stamps follow the duplicate policy and are repo
     for (const auto policy : {posefuse::DuplicateStamps::kFirst, posefuse::DuplicateStamps::kLast}) {
       options.duplicates = policy;
       check_error(expect_io_error([&] { (void)posefuse::read_tum(bad, options); }), bad, 3,
-                  "timestamp 0.05 is smaller than the previous one (0.1 on line 2)");
+                  "timestamp 0.05 is earlier than the previous one (0.1 on line 2)");
     }
   }
   SECTION("policy names parse and print") {

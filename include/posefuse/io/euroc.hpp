@@ -122,15 +122,14 @@ void parse_line(std::string_view line, std::size_t expected, std::string_view la
     values[c - 1] = traj_io::parse_number(f[c], file, line_no, c + 1);
 }
 
-/// Throws when `t_ns` does not follow `previous` strictly.
+/// Throws when `t_ns` does not follow `previous` strictly (IMU samples:
+/// no duplicate policy).
 template <class Lazy = void>
 void check_order(std::int64_t t_ns, std::int64_t previous, std::size_t previous_line,
                  const std::filesystem::path& file, std::size_t line_no) {
   if (t_ns > previous) return;
-  throw io_error(file, line_no,
-                 "timestamp " + std::to_string(t_ns) +
-                     (t_ns == previous ? " repeats" : " is earlier than") + " the previous one (" +
-                     std::to_string(previous) + " on line " + std::to_string(previous_line) + ")");
+  traj_io::throw_stamp_out_of_order(t_ns, previous, previous_line, file, line_no,
+                                    /*offer_policies=*/false);
 }
 
 }  // namespace detail::euroc_io
@@ -216,20 +215,13 @@ template <class Lazy = void>
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
     T.linear() = q.toRotationMatrix();
     T.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
-    bool replace = false;
-    if (!gt.t_ns.empty() && t_ns == gt.t_ns.back() && options.duplicates != DuplicateStamps::kError) {
-      // A repeated stamp under the kFirst / kLast policy (see ReadOptions).
-      if (report != nullptr) {
-        if (report->duplicates_dropped == 0) report->first_duplicate_line = n;
-        ++report->duplicates_dropped;
-      }
-      previous_line = n;
-      if (options.duplicates == DuplicateStamps::kFirst) continue;
-      replace = true;
-    } else if (!gt.t_ns.empty()) {
-      detail::euroc_io::check_order(t_ns, gt.t_ns.back(), previous_line, file, n);
-    }
-    if (replace) {
+    const detail::traj_io::StampAction action =
+        gt.t_ns.empty() ? detail::traj_io::StampAction::kAppend
+                        : detail::traj_io::next_stamp_action(t_ns, gt.t_ns.back(), previous_line,
+                                                             options.duplicates, report, file, n);
+    previous_line = n;
+    if (action == detail::traj_io::StampAction::kSkip) continue;
+    if (action == detail::traj_io::StampAction::kReplaceLast) {
       gt.trajectory.poses.back() = T;
       if (columns == 17) {
         gt.velocity->back() = Eigen::Vector3d(v[7], v[8], v[9]);
@@ -245,7 +237,6 @@ template <class Lazy = void>
       gt.gyro_bias->emplace_back(v[10], v[11], v[12]);
       gt.accel_bias->emplace_back(v[13], v[14], v[15]);
     }
-    previous_line = n;
   }
   if (gt.t_ns.empty()) throw io_error(file, "no ground-truth states (the file has no data lines)");
   return gt;

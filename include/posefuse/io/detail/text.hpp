@@ -17,6 +17,7 @@
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <type_traits>
 #include <vector>
 
 #include <posefuse/core/error.hpp>
@@ -138,13 +139,41 @@ enum class StampAction {
   kReplaceLast,  ///< a repeated stamp under DuplicateStamps::kLast: overwrite the previous row
 };
 
+/// A stamp as text: the shortest exact decimal for seconds (double), the
+/// integer for nanoseconds.
+template <class Stamp>
+[[nodiscard]] std::string stamp_text(Stamp t) {
+  if constexpr (std::is_floating_point_v<Stamp>) {
+    return format_number(double(t));
+  } else {
+    return std::to_string(t);
+  }
+}
+
+/// The error for a stamp `t` that does not follow `previous` (read on
+/// `previous_line`) strictly. `offer_policies`: say that repeats can be
+/// kept first or last instead (for readers that take ReadOptions::duplicates).
+template <class Stamp>
+[[noreturn]] void throw_stamp_out_of_order(Stamp t, Stamp previous, std::size_t previous_line,
+                                           const std::filesystem::path& file, std::size_t line,
+                                           bool offer_policies) {
+  std::string message = "timestamp " + stamp_text(t) +
+                        (t == previous ? " repeats the previous one" : " is earlier than the previous one") +
+                        " (" + stamp_text(previous) + " on line " + std::to_string(previous_line) + ")";
+  if (t == previous && offer_policies)
+    message += "; repeated stamps can be kept first or last instead (--duplicates)";
+  throw io_error(file, line, message);
+}
+
 /// Decides what to do with a row stamped `t` that follows `previous` (read
 /// on `previous_line`), under `policy`; counts dropped rows in `report`.
+/// The one rule of every reader that takes ReadOptions::duplicates; `Stamp`
+/// is double (seconds) or an integer type (nanoseconds).
 /// @throws posefuse::io_error (file:line) for a decreasing stamp, and for a
 ///         repeated one under DuplicateStamps::kError (the message names
 ///         the `--duplicates` choices a program offers)
-template <class Lazy = void>
-[[nodiscard]] StampAction next_stamp_action(double t, double previous, std::size_t previous_line,
+template <class Stamp>
+[[nodiscard]] StampAction next_stamp_action(Stamp t, Stamp previous, std::size_t previous_line,
                                             DuplicateStamps policy, ReadReport* report,
                                             const std::filesystem::path& file,
                                             std::size_t line) {
@@ -156,12 +185,7 @@ template <class Lazy = void>
     }
     return policy == DuplicateStamps::kFirst ? StampAction::kSkip : StampAction::kReplaceLast;
   }
-  std::string message = "timestamp " + format_number(t) +
-                        (t == previous ? " repeats the previous one" : " is smaller than the previous one") +
-                        " (" + format_number(previous) + " on line " + std::to_string(previous_line) +
-                        ")";
-  if (t == previous) message += "; repeated stamps can be kept first or last instead (--duplicates)";
-  throw io_error(file, line, message);
+  throw_stamp_out_of_order(t, previous, previous_line, file, line, /*offer_policies=*/true);
 }
 
 /// Below this orthonormality residual a rotation is kept bit for bit, so
