@@ -25,6 +25,8 @@
 #include <posefuse/filters/complementary.hpp>
 #include <posefuse/filters/ekf.hpp>
 #include <posefuse/filters/rts_smoother.hpp>
+#include <posefuse/fusion/fuse_poses.hpp>
+#include <posefuse/fusion/fuser_status.hpp>
 #include <posefuse/fusion/gated_fuser.hpp>
 #include <posefuse/fusion/threshold_fuser.hpp>
 #include <posefuse/io/association.hpp>

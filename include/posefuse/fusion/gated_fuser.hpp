@@ -72,6 +72,8 @@
 #include <posefuse/core/pipeline.hpp>
 #include <posefuse/core/status.hpp>
 #include <posefuse/filters/ekf.hpp>
+#include <posefuse/fusion/fuse_poses.hpp>
+#include <posefuse/fusion/fuser_status.hpp>
 #include <posefuse/lie/se2.hpp>
 #include <posefuse/lie/so2.hpp>
 #include <posefuse/models/heading_fix.hpp>
@@ -80,148 +82,6 @@
 #include <posefuse/models/se2_odometry.hpp>
 
 namespace posefuse {
-
-/// SE(2) composition \f$a \oplus b\f$ (b expressed in a's frame).
-/// Deprecated: use `SE2` (lie/se2.hpp), `as_se2(a) * as_se2(b)`.
-template <std::floating_point T>
-[[nodiscard]] inline PlanarPose<T> se2_compose(const PlanarPose<T>& a, const PlanarPose<T>& b) {
-  return as_planar_pose(as_se2(a) * as_se2(b));
-}
-
-/// SE(2) inverse \f$a^{-1}\f$.
-/// Deprecated: use `SE2` (lie/se2.hpp), `as_se2(a).inverse()`.
-template <std::floating_point T>
-[[nodiscard]] inline PlanarPose<T> se2_inverse(const PlanarPose<T>& a) {
-  return as_planar_pose(as_se2(a).inverse());
-}
-
-/// A planar pose with its covariance (x, y, theta; m², m·rad, rad²).
-template <std::floating_point T = double>
-struct PlanarPoseWithCov {
-  PlanarPose<T> pose;                                       ///< x, y (m), theta (rad)
-  Eigen::Matrix<T, 3, 3> cov = Eigen::Matrix<T, 3, 3>::Zero();  ///< covariance
-};
-
-/// Information-weighted fusion of two estimates of one planar pose, angle-aware:
-/// one Ekf update of the belief (a, Pa) with b as a PlanarPoseFix of noise Pb,
-/// \f$ K = P_a (P_a + P_b)^{-1},\; x = a \boxplus K (b \boxminus a),\;
-/// P = (I-K) P_a (I-K)^\top + K P_b K^\top = (P_a^{-1} + P_b^{-1})^{-1} \f$,
-/// with the heading residual wrapped, so 179° and -179° with equal weights
-/// fuse to 180°, not 0° (cf. seed eq 15-a).
-/// @param[in] a, Pa first estimate and its covariance
-/// @param[in] b, Pb second estimate and its covariance
-/// @return the fused pose and covariance; NaN when Pa + Pb is not positive
-///         definite or b is not finite
-/// @throws posefuse::invalid_argument if a is not finite, or Pa or Pb is not a
-///         finite symmetric positive semi-definite covariance
-template <std::floating_point T>
-[[nodiscard]] inline PlanarPoseWithCov<T> fuse_poses(const PlanarPose<T>& a,
-                                                     const Eigen::Matrix<T, 3, 3>& Pa,
-                                                     const PlanarPose<T>& b,
-                                                     const Eigen::Matrix<T, 3, 3>& Pb) {
-  Ekf<Se2Odometry<T>> ekf{Se2Odometry<T>{}};  // the motion model is not used
-  ekf.reset(a, Pa);
-  if (!ekf.update_with(PlanarPoseFix<T>(Pb), b)) {
-    constexpr T nan = std::numeric_limits<T>::quiet_NaN();
-    return {{nan, nan, nan}, Eigen::Matrix<T, 3, 3>::Constant(nan)};
-  }
-  return {ekf.state(), ekf.covariance()};
-}
-
-/// How GatedFuser tests a SLAM pose against its prediction.
-enum class GateMode { kSeparate, kMahalanobis, kBoth };
-
-/// What a SLAM pose given to GatedFuser did about the map-frame anchor.
-enum class AnchorEvent {
-  kNone,        ///< nothing: the map frame was anchored already (or not a SLAM pose)
-  kCollecting,  ///< kept to estimate a (new) map frame; not fused
-  kAnchored,    ///< completed the estimate of the map frame; not fused itself
-};
-
-/// Which of GatedFuser's gates rejected a measurement.
-enum class FuserGate {
-  kNone,      ///< none (not rejected)
-  kPosition,  ///< the 2-dof position gate
-  kHeading,   ///< the 1-dof heading gate (SLAM heading or update_heading)
-  kJoint,     ///< the 3-dof Mahalanobis gate
-};
-
-/// Human-readable name of an anchor event.
-[[nodiscard]] constexpr const char* to_string(AnchorEvent e) noexcept {
-  switch (e) {
-    case AnchorEvent::kNone: return "none";
-    case AnchorEvent::kCollecting: return "collecting anchor poses";
-    case AnchorEvent::kAnchored: return "anchored";
-  }
-  return "unknown";
-}
-
-/// Human-readable name of a gate.
-[[nodiscard]] constexpr const char* to_string(FuserGate g) noexcept {
-  switch (g) {
-    case FuserGate::kNone: return "none";
-    case FuserGate::kPosition: return "position gate";
-    case FuserGate::kHeading: return "heading gate";
-    case FuserGate::kJoint: return "joint Mahalanobis gate";
-  }
-  return "unknown";
-}
-
-/// What happened to one measurement given to GatedFuser: the Ekf step's
-/// FilterStatus, plus, for SLAM poses, the anchoring event and which gate
-/// rejected it. Converts implicitly from a FilterStatus (no anchoring event,
-/// no gate). The named constants are the common outcomes; compare with `==`.
-struct FuserStatus {
-  /// The filter step: kApplied (fused), kGated (see rejected_by), kNonFinite,
-  /// kInvalidInput, kNotPositiveDefinite; kNotInitialised when the pose went
-  /// to the anchor estimate instead (see anchor).
-  FilterStatus step = FilterStatus::kApplied;
-  AnchorEvent anchor = AnchorEvent::kNone;    ///< anchoring (SLAM poses)
-  FuserGate rejected_by = FuserGate::kNone;   ///< the gate that failed, when step == kGated
-
-  /// Applied, nothing else happened.
-  constexpr FuserStatus() noexcept = default;
-  /// A step outcome with its anchoring event and rejecting gate.
-  constexpr FuserStatus(FilterStatus s, AnchorEvent a = AnchorEvent::kNone,  // NOLINT: implicit
-                        FuserGate g = FuserGate::kNone) noexcept
-      : step(s), anchor(a), rejected_by(g) {}
-
-  /// True when the measurement changed the estimate.
-  [[nodiscard]] constexpr bool applied() const noexcept { return step == FilterStatus::kApplied; }
-  /// All fields equal.
-  friend constexpr bool operator==(const FuserStatus&, const FuserStatus&) noexcept = default;
-
-  static const FuserStatus kFused;              ///< {kApplied}: passed the gates and was fused
-  static const FuserStatus kRejectedPosition;   ///< {kGated, -, kPosition}
-  static const FuserStatus kRejectedHeading;    ///< {kGated, -, kHeading}
-  static const FuserStatus kRejectedJoint;      ///< {kGated, -, kJoint}
-  static const FuserStatus kAnchoring;          ///< {kNotInitialised, kCollecting}
-  static const FuserStatus kAnchored;           ///< {kNotInitialised, kAnchored}
-  static const FuserStatus kNonFinite;          ///< {kNonFinite}: NaN/Inf input; state untouched
-  static const FuserStatus kSingularInnovation; ///< {kNotPositiveDefinite}; state untouched
-  /// {kApplied}, the same value as kFused: kept for code written when
-  /// predict() returned a FuserStatus (it now returns the FilterStatus).
-  static const FuserStatus kPredicted;
-};
-inline constexpr FuserStatus FuserStatus::kFused{FilterStatus::kApplied};
-inline constexpr FuserStatus FuserStatus::kRejectedPosition{FilterStatus::kGated, AnchorEvent::kNone,
-                                                            FuserGate::kPosition};
-inline constexpr FuserStatus FuserStatus::kRejectedHeading{FilterStatus::kGated, AnchorEvent::kNone,
-                                                           FuserGate::kHeading};
-inline constexpr FuserStatus FuserStatus::kRejectedJoint{FilterStatus::kGated, AnchorEvent::kNone,
-                                                         FuserGate::kJoint};
-inline constexpr FuserStatus FuserStatus::kAnchoring{FilterStatus::kNotInitialised,
-                                                     AnchorEvent::kCollecting};
-inline constexpr FuserStatus FuserStatus::kAnchored{FilterStatus::kNotInitialised,
-                                                    AnchorEvent::kAnchored};
-inline constexpr FuserStatus FuserStatus::kNonFinite{FilterStatus::kNonFinite};
-inline constexpr FuserStatus FuserStatus::kSingularInnovation{FilterStatus::kNotPositiveDefinite};
-inline constexpr FuserStatus FuserStatus::kPredicted{FilterStatus::kApplied};
-
-/// True when a gate rejected the measurement.
-[[nodiscard]] constexpr bool is_rejection(const FuserStatus& s) noexcept {
-  return s.step == FilterStatus::kGated;
-}
 
 /// Parameters of GatedFuser. Sigmas are 1-σ; gates are χ² quantiles.
 template <std::floating_point T = double>

@@ -58,6 +58,20 @@ template <std::floating_point T>
   return {g.x(), g.y(), g.angle()};
 }
 
+/// SE(2) composition \f$a \oplus b\f$ (b expressed in a's frame).
+/// Deprecated: use `SE2` (lie/se2.hpp), `as_se2(a) * as_se2(b)`.
+template <std::floating_point T>
+[[nodiscard]] inline PlanarPose<T> se2_compose(const PlanarPose<T>& a, const PlanarPose<T>& b) {
+  return as_planar_pose(as_se2(a) * as_se2(b));
+}
+
+/// SE(2) inverse \f$a^{-1}\f$.
+/// Deprecated: use `SE2` (lie/se2.hpp), `as_se2(a).inverse()`.
+template <std::floating_point T>
+[[nodiscard]] inline PlanarPose<T> se2_inverse(const PlanarPose<T>& a) {
+  return as_planar_pose(as_se2(a).inverse());
+}
+
 /// Noise of Se2Odometry: 1-σ growth per √distance and per √angle turned.
 template <std::floating_point T = double>
 struct Se2OdometryNoise {
