@@ -454,7 +454,7 @@ TEST_CASE("PoseGraph4Dof: the planar path equals the 4-DoF path on a planar grap
   CHECK(sa.final_cost == Approx(sb.final_cost).epsilon(1e-12));
   CHECK(sa.iterations == sb.iterations);
   CHECK(sa.termination == sb.termination);
-  CHECK(sa.final_cost < 0.01 * sa.initial_cost);
+  CHECK(sa.final_cost < 0.5 * sa.initial_cost);  // noise-level chi2 (~257) from a drifting start (~860)
   double worst = 0.0;
   for (int k = 0; k < n; ++k) {
     const Pose4Dof& pa = a.pose(k);
