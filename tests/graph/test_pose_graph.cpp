@@ -464,7 +464,7 @@ TEST_CASE("PoseGraph4Dof: the planar path equals the 4-DoF path on a planar grap
     worst = std::max({worst, (pa.p - pb.p).norm(), std::abs(wrap_angle(pa.yaw - pb.yaw))});
     CHECK(pa.p.z() == 0.0);
   }
-  CHECK(worst < 1e-9);
+  CHECK(worst < 1e-10);
   // Solving again after the buffers were released gives the same answer.
   PoseGraph4Dof::release_workspace();
   PoseGraph4Dof a2 = start_graph;
