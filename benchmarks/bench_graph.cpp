@@ -12,6 +12,29 @@
 //                                block per pose, LM, SPARSE_NORMAL_CHOLESKY,
 //                                function tolerance 1e-10, one thread
 //
+//   BM_G2o/posefuse/G            the real planar g2o file G (manhattan, mit) end
+//                                to end from its parsed contents: build the
+//                                graph, rotation-first start, optimize() (the
+//                                planar 3x3-block path)
+//   BM_G2o/posefuse_4dof/G       the same on the general 4x4-block path
+//                                (planar_fast_path = false), for comparison
+//   BM_G2o/ceres_file/G          Ceres from the file's poses, as Ceres's own
+//                                pose_graph_2d example starts: one [x y yaw]
+//                                block per vertex, autodiff of g2o's EDGE_SE2
+//                                error (translation error in the
+//                                measurement's frame), LM,
+//                                SPARSE_NORMAL_CHOLESKY, function tolerance
+//                                1e-10, at most 100 iterations, one thread
+//   BM_G2o/ceres_rotation_first/G  the same Ceres solve started from
+//                                posefuse's rotation-first poses (computed
+//                                once, outside the timing)
+//
+// The files are found as $POSEFUSE_DATA_DIR/posegraph, else
+// ../shared/data/posegraph from the working directory, else the build's
+// POSEFUSE_DATA_DIR; without them those rows stop with "SKIPPED: ...".
+// File parsing is outside the timing of every row; the first vertex is
+// held fixed in both solvers (the files have no FIX line).
+//
 // Counters: chi2 (g2o convention, = 2x Ceres's cost), iterations. Run Ceres
 // with OMP_THREAD_LIMIT=1 (Debian's CHOLMOD otherwise starts OpenMP threads):
 //
@@ -20,14 +43,20 @@
 
 #include <benchmark/benchmark.h>
 
+#include <array>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <map>
+#include <optional>
+#include <string>
 #include <random>
 #include <numbers>
 
 #include <apps/sim/pose_graph_4dof.hpp>
+#include <posefuse/graph/g2o_graph.hpp>
 #include <posefuse/graph/pose_graph_4dof.hpp>
+#include <posefuse/io/g2o.hpp>
 
 #ifdef POSEFUSE_HAVE_CERES
 #include <ceres/ceres.h>
@@ -64,6 +93,62 @@ BENCHMARK(BM_PoseGraph4Dof_posefuse)
     ->Name("BM_PoseGraph4Dof/posefuse")
     ->Arg(1000)->Arg(10000)->Arg(100000)
     ->Unit(benchmark::kMillisecond);
+
+/// The real g2o files (see the file comment), parsed once; nullopt when absent.
+const std::optional<G2oGraph2d>& real_graph(const std::string& file) {
+  static std::map<std::string, std::optional<G2oGraph2d>> cache;
+  auto it = cache.find(file);
+  if (it != cache.end()) return it->second;
+  std::vector<std::filesystem::path> dirs;
+  if (const char* d = std::getenv("POSEFUSE_DATA_DIR"); d != nullptr && *d != '\0') dirs.emplace_back(d);
+  dirs.emplace_back("../shared/data");
+#ifdef POSEFUSE_DEFAULT_DATA_DIR
+  dirs.emplace_back(POSEFUSE_DEFAULT_DATA_DIR);
+#endif
+  std::optional<G2oGraph2d> g;
+  for (const auto& d : dirs) {
+    const std::filesystem::path p = d / "posegraph" / file;
+    if (std::filesystem::is_regular_file(p)) {
+      g = read_g2o_2d(p);
+      break;
+    }
+  }
+  return cache.emplace(file, std::move(g)).first->second;
+}
+
+const char* g2o_file(int which) { return which == 0 ? "manhattanOlson3500.g2o" : "input_MITb_g2o.g2o"; }
+
+bool skip_without(benchmark::State& state, const std::optional<G2oGraph2d>& g, int which) {
+  if (g) return false;
+  state.SkipWithError((std::string("SKIPPED: posegraph/") + g2o_file(which) +
+                       " not found (set POSEFUSE_DATA_DIR to the folder holding posegraph/)")
+                          .c_str());
+  return true;
+}
+
+void run_g2o_posefuse(benchmark::State& state, bool planar) {
+  const int which = static_cast<int>(state.range(0));
+  const std::optional<G2oGraph2d>& g = real_graph(g2o_file(which));
+  if (skip_without(state, g, which)) return;
+  PoseGraphOptions o;
+  o.planar_fast_path = planar;
+  PoseGraphSummary s;
+  for (auto _ : state) {
+    PoseGraph4Dof graph = pose_graph_from_g2o(*g);
+    graph.initialize_rotation_first();
+    s = graph.optimize(o);
+    benchmark::DoNotOptimize(s);
+  }
+  state.counters["chi2"] = s.final_cost;
+  state.counters["iterations"] = s.iterations;
+  state.counters["planar"] = s.planar ? 1 : 0;
+  state.SetLabel(which == 0 ? "manhattan" : "mit");
+}
+void BM_G2o_posefuse(benchmark::State& state) { run_g2o_posefuse(state, true); }
+void BM_G2o_posefuse_4dof(benchmark::State& state) { run_g2o_posefuse(state, false); }
+// Arg 0 = Manhattan 3500, 1 = MIT Killian Court.
+BENCHMARK(BM_G2o_posefuse)->Name("BM_G2o/posefuse")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_G2o_posefuse_4dof)->Name("BM_G2o/posefuse_4dof")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 #ifdef POSEFUSE_HAVE_CERES
 
@@ -142,6 +227,94 @@ void BM_PoseGraph4Dof_ceres(benchmark::State& state) {
 BENCHMARK(BM_PoseGraph4Dof_ceres)
     ->Name("BM_PoseGraph4Dof/ceres")
     ->Arg(1000)->Arg(10000)->Arg(100000)
+    ->Unit(benchmark::kMillisecond);
+
+
+/// g2o's EDGE_SE2 error t2v(Z⁻¹ X_a⁻¹ X_b) on [x y yaw] blocks, whitened
+/// by the information's upper Cholesky factor (for Ceres's autodiff).
+struct EdgeSE2Error {
+  double dx, dy, dyaw;
+  Eigen::Matrix3d sqrt_info;
+
+  template <class T>
+  bool operator()(const T* a, const T* b, T* residual) const {
+    const T d0 = b[0] - a[0], d1 = b[1] - a[1];
+    const T ca = ceres::cos(a[2]), sa = ceres::sin(a[2]);
+    const T u0 = ca * d0 + sa * d1 - dx, u1 = -sa * d0 + ca * d1 - dy;
+    const double cm = std::cos(dyaw), sm = std::sin(dyaw);
+    T e[3];
+    e[0] = cm * u0 + sm * u1;
+    e[1] = -sm * u0 + cm * u1;
+    e[2] = wrap(b[2] - a[2] - T(dyaw));
+    for (int r = 0; r < 3; ++r) {
+      residual[r] = T(0);
+      for (int c = r; c < 3; ++c) residual[r] += T(sqrt_info(r, c)) * e[c];
+    }
+    return true;
+  }
+};
+
+/// posefuse's rotation-first start of a file (computed once per file).
+const std::vector<std::array<double, 3>>& rotation_first_start(int which) {
+  static std::map<int, std::vector<std::array<double, 3>>> cache;
+  auto it = cache.find(which);
+  if (it == cache.end()) {
+    PoseGraph4Dof graph = pose_graph_from_g2o(*real_graph(g2o_file(which)));
+    graph.initialize_rotation_first();
+    std::vector<std::array<double, 3>> x;
+    for (const Pose4Dof& p : graph.poses()) x.push_back({p.p.x(), p.p.y(), p.yaw});
+    it = cache.emplace(which, std::move(x)).first;
+  }
+  return it->second;
+}
+
+void run_g2o_ceres(benchmark::State& state, bool from_file) {
+  const int which = static_cast<int>(state.range(0));
+  const std::optional<G2oGraph2d>& g = real_graph(g2o_file(which));
+  if (skip_without(state, g, which)) return;
+  std::vector<std::array<double, 3>> start;
+  if (from_file) {
+    for (const G2oVertexSE2& v : g->vertices) start.push_back({v.x, v.y, v.theta});
+  } else {
+    start = rotation_first_start(which);
+  }
+  std::map<std::int64_t, std::size_t> index;
+  for (std::size_t k = 0; k < g->vertices.size(); ++k) index[g->vertices[k].id] = k;
+  double chi2 = 0;
+  int iterations = 0;
+  for (auto _ : state) {
+    std::vector<std::array<double, 3>> x = start;
+    ceres::Problem problem;
+    for (const G2oEdgeSE2& e : g->edges) {
+      EdgeSE2Error f{e.dx, e.dy, e.dtheta, e.information.llt().matrixU()};
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<EdgeSE2Error, 3, 3, 3>(new EdgeSE2Error(f)),
+                               nullptr, x[index.at(e.from)].data(), x[index.at(e.to)].data());
+    }
+    problem.SetParameterBlockConstant(x[0].data());
+    ceres::Solver::Options o;
+    o.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+    o.max_num_iterations = 100;
+    o.function_tolerance = 1e-10;
+    o.num_threads = 1;
+    ceres::Solver::Summary summary;
+    ceres::Solve(o, &problem, &summary);
+    chi2 = 2.0 * summary.final_cost;
+    iterations = static_cast<int>(summary.iterations.size()) - 1;
+    benchmark::DoNotOptimize(x.data());
+  }
+  state.counters["chi2"] = chi2;
+  state.counters["iterations"] = iterations;
+  std::string label = which == 0 ? "manhattan" : "mit";
+  const char* limit = std::getenv("OMP_THREAD_LIMIT");
+  if (limit == nullptr || std::string(limit) != "1") label += " OMP_THREAD_LIMIT is not 1";
+  state.SetLabel(label);
+}
+void BM_G2o_ceres_file(benchmark::State& state) { run_g2o_ceres(state, true); }
+void BM_G2o_ceres_rotation_first(benchmark::State& state) { run_g2o_ceres(state, false); }
+BENCHMARK(BM_G2o_ceres_file)->Name("BM_G2o/ceres_file")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_G2o_ceres_rotation_first)
+    ->Name("BM_G2o/ceres_rotation_first")
+    ->Arg(0)->Arg(1)
     ->Unit(benchmark::kMillisecond);
 
 #endif

@@ -3,6 +3,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -100,6 +101,8 @@ TEST_CASE("g2o: malformed lines name file:line", "[graph][g2o]") {
   expect("VERTEX_SE2 0 0 0 0\nVERTEX_XY 1 0 0\n", "2:", "unsupported g2o tag 'VERTEX_XY'");
   expect("VERTEX_SE2 0 0 0 nan\n", "1:", "non-finite");
   expect("VERTEX_SE2 0 0 0 0\nEDGE_SE2 0 1 1 0 0 1 2 0 1 0 1\n", "2:", "not positive semi-definite");
+  expect("VERTEX_SE2 4 0 0 0\nVERTEX_SE2 5 1 0 0\n# again\nVERTEX_SE2 4 2 0 0\n", "4:",
+         "duplicate vertex id 4 (first defined on line 1)");
   const auto empty = write_text(dir, "empty.g2o", "# nothing\n");
   CHECK_THROWS_WITH(read_g2o_2d(empty), Catch::Contains("no VERTEX_SE2"));
   const auto loops = write_text(dir, "loops.txt", "0 1 1 0 0 0 1 0 0 0 1 0 0 1 0 1\n0 1 1 0 0\n");
@@ -142,6 +145,34 @@ TEST_CASE("g2o: MIT Killian Court converges from the rotation-first start", "[gr
   INFO("chi2 " << s.final_cost << " after " << s.iterations << " iterations, " << to_string(s.termination));
   CHECK(s.termination == Termination::kFunctionTolerance);
   CHECK(s.final_cost < 41.2);  // README: 41.163 (from the file's poses LM stalls above 2000)
+  CHECK(s.planar);
+}
+
+TEST_CASE("g2o: the planar path equals the 4-DoF path on the real files", "[graph][g2o][data][planar]") {
+  POSEFUSE_REQUIRE_DATASET(dir, "posegraph");
+  for (const char* name : {"input_MITb_g2o.g2o", "manhattanOlson3500.g2o"}) {
+    INFO(name);
+    const G2oGraph2d file = read_g2o_2d(dir / name);
+    PoseGraph4Dof a = pose_graph_from_g2o(file);
+    a.initialize_rotation_first();
+    PoseGraph4Dof b = a;
+    PoseGraphOptions general;
+    general.planar_fast_path = false;
+    const PoseGraphSummary sa = a.optimize();
+    const PoseGraphSummary sb = b.optimize(general);
+    INFO("planar " << sa.final_cost << " in " << sa.iterations << ", 4-DoF " << sb.final_cost << " in "
+                   << sb.iterations);
+    CHECK(sa.planar);
+    CHECK_FALSE(sb.planar);
+    CHECK(sa.iterations == sb.iterations);
+    CHECK(sa.final_cost == Approx(sb.final_cost).epsilon(1e-12));
+    double worst = 0.0;
+    for (std::size_t k = 0; k < a.num_nodes(); ++k)
+      worst = std::max({worst, (a.poses()[k].p - b.poses()[k].p).norm(),
+                        std::abs(wrap_angle(a.poses()[k].yaw - b.poses()[k].yaw))});
+    INFO("largest pose difference " << worst);
+    CHECK(worst < 1e-10);  // measured 1.1e-11 (MIT, coordinates up to 249 m), 1.5e-13 (Manhattan)
+  }
 }
 
 TEST_CASE("optimize_pose_graph: built-in graph, JSON, --out and errors", "[graph][examples]") {

@@ -3,6 +3,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -327,4 +328,162 @@ TEST_CASE("align_posyaw: recovers a known 4-DoF (position + yaw) transform exact
   still.push_back(0.0, Eigen::Isometry3d::Identity());
   still.push_back(1.0, Eigen::Isometry3d::Identity());
   CHECK_THROWS_WITH(align_posyaw(still, still), Catch::Contains("no horizontal spread"));
+}
+
+namespace {
+
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+
+/// The planar edge error as a function of [x_i, y_i, ψ_i, x_j, y_j, ψ_j].
+struct PlanarErrorOf {
+  Eigen::Vector2d dp;
+  double dyaw;
+  Eigen::Vector3d operator()(const Vec6& x) const {
+    return edge_error_planar(x.head<2>(), x(2), x.segment<2>(3), x(5), dp, dyaw);
+  }
+};
+
+Eigen::Matrix<double, 3, 6> analytic_planar(const PlanarErrorOf& f, const Vec6& x, bool flip = false) {
+  Eigen::Matrix3d Ji, Jj;
+  (void)edge_error_planar(x.head<2>(), x(2), x.segment<2>(3), x(5), f.dp, f.dyaw, &Ji, &Jj);
+  Eigen::Matrix<double, 3, 6> J;
+  J << Ji, Jj;
+  if (flip) J(0, 2) = -J(0, 2);
+  return J;
+}
+
+}  // namespace
+
+TEST_CASE("edge_error_planar: Jacobians match central differences and equal the 4-DoF ones", "[graph][jacobian]") {
+  std::mt19937 rng(17);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  int checked = 0;
+  for (int trial = 0; trial < 50; ++trial) {
+    Vec6 x;
+    for (int r = 0; r < 6; ++r) x(r) = 2.0 * n01(rng);
+    x(2) = wrap_angle(x(2));
+    x(5) = wrap_angle(x(5));
+    const PlanarErrorOf f{Eigen::Vector2d(n01(rng), n01(rng)), n01(rng)};
+    if (std::abs(wrap_angle(x(5) - x(2) - f.dyaw)) > 3.0) continue;
+    const testing::CheckResult r = testing::check_jacobian("edge_error_planar", f, x, analytic_planar(f, x), 1e-6);
+    INFO(r);
+    CHECK(r.ok);
+    // The 4-DoF error at z = 0 without roll or pitch, rows and columns (x, y, yaw).
+    Eigen::Matrix3d Pi, Pj;
+    const Eigen::Vector3d e3 = edge_error_planar(x.head<2>(), x(2), x.segment<2>(3), x(5), f.dp, f.dyaw, &Pi, &Pj);
+    Eigen::Matrix4d Ji, Jj;
+    const Eigen::Vector4d e4 = edge_error_4dof(Eigen::Vector3d(x(0), x(1), 0.0), x(2), Eigen::Matrix3d::Identity(),
+                                               Eigen::Vector3d(x(3), x(4), 0.0), x(5),
+                                               Eigen::Vector3d(f.dp.x(), f.dp.y(), 0.0), f.dyaw, &Ji, &Jj);
+    const int map[3] = {0, 1, 3};
+    for (int a = 0; a < 3; ++a) {
+      CHECK(e3(a) == Approx(e4(map[a])).margin(1e-12));
+      for (int b = 0; b < 3; ++b) {
+        CHECK(Pi(a, b) == Approx(Ji(map[a], map[b])).margin(1e-12));
+        CHECK(Pj(a, b) == Approx(Jj(map[a], map[b])).margin(1e-12));
+      }
+    }
+    CHECK(e4(2) == 0.0);
+    ++checked;
+  }
+  CHECK(checked > 40);
+  const PlanarErrorOf f{Eigen::Vector2d(1.0, -0.5), 0.4};
+  Vec6 x;
+  x << 0.3, -1.0, 0.7, 2.0, 1.0, 1.2;
+  CHECK_FALSE(testing::check_jacobian("flipped", f, x, analytic_planar(f, x, true), 1e-6).ok);
+}
+
+TEST_CASE("PoseGraph4Dof: the planar path equals the 4-DoF path on a planar graph", "[graph][optimize][planar]") {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  // A planar drive: 300 poses on laps of a circle, odometry and loop edges
+  // with full (correlated) 3x3 information, a Cauchy loss on the loops.
+  const int n = 300;
+  std::vector<Pose4Dof> truth(n);
+  for (int k = 0; k < n; ++k) {
+    const double s = 2.0 * std::numbers::pi * (k % 50) / 50.0;
+    truth[std::size_t(k)].p = Eigen::Vector3d(8.0 * std::cos(s), 8.0 * std::sin(s), 0.0);
+    truth[std::size_t(k)].yaw = wrap_angle(s + std::numbers::pi / 2);
+  }
+  const auto make = [&](std::int64_t i, std::int64_t j, double sp, double sy, bool robust) {
+    Edge4Dof e = exact_edge(truth[std::size_t(i)], truth[std::size_t(j)], i, j);
+    e.dp += Eigen::Vector3d(sp * n01(rng), sp * n01(rng), 0.0);
+    e.dyaw = wrap_angle(e.dyaw + sy * n01(rng));
+    Eigen::Matrix3d A;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) A(r, c) = 0.3 * n01(rng);
+    Eigen::Matrix3d I3 = (A * A.transpose() + Eigen::Matrix3d::Identity());
+    I3.topLeftCorner<2, 2>() /= sp * sp;
+    I3.col(2).head<2>() /= sp * sy;
+    I3.row(2).head<2>() /= sp * sy;
+    I3(2, 2) /= sy * sy;
+    e.information.setZero();
+    const int map[3] = {0, 1, 3};
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) e.information(map[r], map[c]) = I3(r, c);
+    e.information(2, 2) = 1.0;
+    if (robust) e.loss = RobustKernel{RobustLoss::kCauchy, 2.0};
+    return e;
+  };
+  std::vector<Edge4Dof> edges;
+  for (int k = 0; k + 1 < n; ++k) edges.push_back(make(k, k + 1, 0.05, 0.01, false));
+  for (int k = 50; k < n; k += 3) edges.push_back(make(k - 50, k, 0.1, 0.02, true));
+  PoseGraph4Dof a;
+  Pose4Dof start = truth[0];
+  for (int k = 0; k < n; ++k) {
+    if (k > 0) {  // chained odometry, the drifting start
+      const Edge4Dof& e = edges[std::size_t(k - 1)];
+      const Pose4Dof& prev = a.poses().back();
+      start.p = prev.p + Eigen::Vector3d(std::cos(prev.yaw) * e.dp.x() - std::sin(prev.yaw) * e.dp.y(),
+                                         std::sin(prev.yaw) * e.dp.x() + std::cos(prev.yaw) * e.dp.y(), 0.0);
+      start.yaw = wrap_angle(prev.yaw + e.dyaw);
+    }
+    a.add_node(k, start, k == 0);
+  }
+  for (const Edge4Dof& e : edges) a.add_edge(e);
+  REQUIRE(a.is_planar());
+  const PoseGraph4Dof start_graph = a;
+  PoseGraph4Dof b = a;
+  PoseGraphOptions planar, general;
+  general.planar_fast_path = false;
+  const PoseGraphSummary sa = a.optimize(planar);
+  const PoseGraphSummary sb = b.optimize(general);
+  CHECK(sa.planar);
+  CHECK_FALSE(sb.planar);
+  INFO("planar " << sa.final_cost << " in " << sa.iterations << ", 4-DoF " << sb.final_cost << " in "
+                 << sb.iterations);
+  CHECK(sa.initial_cost == Approx(sb.initial_cost).epsilon(1e-12));
+  CHECK(sa.final_cost == Approx(sb.final_cost).epsilon(1e-12));
+  CHECK(sa.iterations == sb.iterations);
+  CHECK(sa.termination == sb.termination);
+  CHECK(sa.final_cost < 0.5 * sa.initial_cost);  // noise-level chi2 (~257) from a drifting start (~860)
+  double worst = 0.0;
+  for (int k = 0; k < n; ++k) {
+    const Pose4Dof& pa = a.pose(k);
+    const Pose4Dof& pb = b.pose(k);
+    worst = std::max({worst, (pa.p - pb.p).norm(), std::abs(wrap_angle(pa.yaw - pb.yaw))});
+    CHECK(pa.p.z() == 0.0);
+  }
+  CHECK(worst < 1e-10);
+  // Solving again after the buffers were released gives the same answer.
+  PoseGraph4Dof::release_workspace();
+  PoseGraph4Dof a2 = start_graph;
+  const PoseGraphSummary sa2 = a2.optimize(planar);
+  CHECK(sa2.final_cost == sa.final_cost);
+  CHECK(sa2.iterations == sa.iterations);
+  // A z offset, roll or a z-coupled information makes the graph non-planar.
+  PoseGraph4Dof c = a;
+  Pose4Dof p = c.pose(5);
+  p.p.z() = 1e-3;
+  c.set_pose(5, p);
+  CHECK_FALSE(c.is_planar());
+  CHECK_FALSE(c.optimize().planar);
+  PoseGraph4Dof d;
+  d.add_node(0, Pose4Dof{});
+  d.add_node(1, Pose4Dof{});
+  Edge4Dof e;
+  e.to = 1;
+  e.information(0, 2) = e.information(2, 0) = 0.1;
+  d.add_edge(e);
+  CHECK_FALSE(d.is_planar());
 }

@@ -116,6 +116,7 @@ inline PoseGraphProblem make_pose_graph_problem(const PoseGraphProblemConfig& c)
 /// The problem as a PoseGraph4Dof started from its initial guess (node 0 fixed).
 inline PoseGraph4Dof to_pose_graph(const PoseGraphProblem& pr, const RobustKernel& loop_loss = {}) {
   PoseGraph4Dof g;
+  g.reserve(pr.initial.size(), pr.edges.size());
   for (std::size_t k = 0; k < pr.initial.size(); ++k)
     g.add_node(static_cast<std::int64_t>(k), pr.initial[k], k == 0);
   for (std::size_t k = 0; k < pr.edges.size(); ++k) {

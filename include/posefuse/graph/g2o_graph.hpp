@@ -38,6 +38,7 @@ template <class Lazy = void>
 template <class Lazy = void>
 [[nodiscard]] PoseGraph4Dof pose_graph_from_g2o(const G2oGraph2d& g, const RobustKernel& loss = {}) {
   PoseGraph4Dof graph;
+  graph.reserve(g.vertices.size(), g.edges.size());
   for (const G2oVertexSE2& v : g.vertices)
     graph.add_node(v.id, Pose4Dof{Eigen::Vector3d(v.x, v.y, 0.0), v.theta, 0.0, 0.0});
   for (const std::int64_t id : g.fixed) graph.set_fixed(id);

@@ -124,6 +124,74 @@ template <class Lazy = void>
   return Eigen::Vector3d(q.x(), q.y(), v.z());
 }
 
+namespace detail {
+
+/// edge_error_4dof from precomputed trigonometry: \f$ (c_i, s_i) \f$ of
+/// \f$ \psi_i \f$ and \f$ (c_m, s_m) \f$ of \f$ \Delta\psi \f$ (the optimiser
+/// computes them once per node and once per edge instead of twice per edge).
+template <class Lazy = void>
+[[nodiscard]] Eigen::Vector4d edge_error_4dof_trig(const Eigen::Vector3d& pi, double yaw_i, double ci, double si,
+                                                   const Eigen::Matrix3d& Qi_t, const Eigen::Vector3d& pj,
+                                                   double yaw_j, const Eigen::Vector3d& dp, double dyaw, double cm,
+                                                   double sm, Eigen::Matrix4d* J_e_xi, Eigen::Matrix4d* J_e_xj) {
+  const Eigen::Vector3d d = pj - pi;
+  const Eigen::Vector3d w(ci * d.x() + si * d.y(), -si * d.x() + ci * d.y(), d.z());  // R_z(ψ_i)^T d
+  const Eigen::Vector3d v = Qi_t * w - dp;                                              // R_i^T d - Δp
+  Eigen::Vector4d e(cm * v.x() + sm * v.y(), -sm * v.x() + cm * v.y(), v.z(), wrap_angle(yaw_j - yaw_i - dyaw));
+  if (J_e_xi || J_e_xj) {
+    Eigen::Matrix3d Rzi_t;
+    Rzi_t << ci, si, 0.0, -si, ci, 0.0, 0.0, 0.0, 1.0;
+    Eigen::Matrix3d Mm;
+    Mm << cm, sm, 0.0, -sm, cm, 0.0, 0.0, 0.0, 1.0;
+    const Eigen::Matrix3d A = Mm * Qi_t * Rzi_t;  // M R_i^T
+    if (J_e_xi) {
+      J_e_xi->setZero();
+      J_e_xi->topLeftCorner<3, 3>() = -A;
+      // d w / d ψ_i = (w_y, -w_x, 0).
+      J_e_xi->block<3, 1>(0, 3) = Mm * (Qi_t * Eigen::Vector3d(w.y(), -w.x(), 0.0));
+      (*J_e_xi)(3, 3) = -1.0;
+    }
+    if (J_e_xj) {
+      J_e_xj->setZero();
+      J_e_xj->topLeftCorner<3, 3>() = A;
+      (*J_e_xj)(3, 3) = 1.0;
+    }
+  }
+  return e;
+}
+
+/// edge_error_planar from precomputed trigonometry (see edge_error_4dof_trig).
+template <class Lazy = void>
+[[nodiscard]] Eigen::Vector3d edge_error_planar_trig(const Eigen::Vector2d& pi, double yaw_i, double ci, double si,
+                                                     const Eigen::Vector2d& pj, double yaw_j,
+                                                     const Eigen::Vector2d& dp, double dyaw, double cm, double sm,
+                                                     Eigen::Matrix3d* J_e_xi, Eigen::Matrix3d* J_e_xj) {
+  const Eigen::Vector2d d = pj - pi;
+  const Eigen::Vector2d w(ci * d.x() + si * d.y(), -si * d.x() + ci * d.y());  // R(ψ_i)^T d
+  const Eigen::Vector2d v = w - dp;
+  Eigen::Vector3d e(cm * v.x() + sm * v.y(), -sm * v.x() + cm * v.y(), wrap_angle(yaw_j - yaw_i - dyaw));
+  if (J_e_xi || J_e_xj) {
+    Eigen::Matrix2d Rzi_t, Mm;
+    Rzi_t << ci, si, -si, ci;
+    Mm << cm, sm, -sm, cm;
+    const Eigen::Matrix2d A = Mm * Rzi_t;
+    if (J_e_xi) {
+      J_e_xi->setZero();
+      J_e_xi->topLeftCorner<2, 2>() = -A;
+      J_e_xi->block<2, 1>(0, 2) = Mm * Eigen::Vector2d(w.y(), -w.x());
+      (*J_e_xi)(2, 2) = -1.0;
+    }
+    if (J_e_xj) {
+      J_e_xj->setZero();
+      J_e_xj->topLeftCorner<2, 2>() = A;
+      (*J_e_xj)(2, 2) = 1.0;
+    }
+  }
+  return e;
+}
+
+}  // namespace detail
+
 /// The 4-DoF edge error \f$ e = [e_t; e_\psi] \f$ (see the file comment) and
 /// its Jacobians with respect to \f$ x_i = [p_i; \psi_i] \f$ and \f$ x_j \f$.
 /// @param[in] Qi_t \f$ Q_i^\top \f$, node i's fixed roll/pitch rotation transposed
@@ -140,35 +208,23 @@ template <class Lazy = void>
                                               const Eigen::Vector3d& dp, double dyaw,
                                               Eigen::Matrix4d* J_e_xi = nullptr,
                                               Eigen::Matrix4d* J_e_xj = nullptr) {
-  const Eigen::Vector3d d = pj - pi;
-  Eigen::Vector3d J_w_psi;
-  const Eigen::Vector3d w = rotate_z_inverse(yaw_i, d, &J_w_psi);  // R_z(ψ_i)^T d
-  const Eigen::Vector3d u = Qi_t * w;                              // R_i^T d
-  const Eigen::Vector3d et = rotate_z_inverse(dyaw, u - dp);
-  Eigen::Vector4d e;
-  e << et, wrap_angle(yaw_j - yaw_i - dyaw);
-  if (J_e_xi || J_e_xj) {
-    // M R_i^T = M Q_i^T R_z(ψ_i)^T: columns are M Q_i^T R_z(ψ_i)^T applied to unit vectors.
-    const SO2<double> Rz_i(yaw_i);
-    const SO2<double> M(-dyaw);
-    Eigen::Matrix3d Rzi_t = Eigen::Matrix3d::Identity();
-    Rzi_t.topLeftCorner<2, 2>() = Rz_i.matrix().transpose();
-    Eigen::Matrix3d Mm = Eigen::Matrix3d::Identity();
-    Mm.topLeftCorner<2, 2>() = M.matrix();
-    const Eigen::Matrix3d A = Mm * Qi_t * Rzi_t;
-    if (J_e_xi) {
-      J_e_xi->setZero();
-      J_e_xi->topLeftCorner<3, 3>() = -A;
-      J_e_xi->block<3, 1>(0, 3) = Mm * (Qi_t * J_w_psi);
-      (*J_e_xi)(3, 3) = -1.0;
-    }
-    if (J_e_xj) {
-      J_e_xj->setZero();
-      J_e_xj->topLeftCorner<3, 3>() = A;
-      (*J_e_xj)(3, 3) = 1.0;
-    }
-  }
-  return e;
+  return detail::edge_error_4dof_trig(pi, yaw_i, std::cos(yaw_i), std::sin(yaw_i), Qi_t, pj, yaw_j, dp, dyaw,
+                                      std::cos(dyaw), std::sin(dyaw), J_e_xi, J_e_xj);
+}
+
+/// The planar edge error (g2o's EDGE_SE2 error,
+/// \f$ t2v(Z^{-1} X_i^{-1} X_j) \f$): edge_error_4dof with z = 0 and no roll
+/// or pitch, on \f$ x_i = [x_i, y_i, \psi_i] \f$:
+/// \f$ e = [R(\Delta\psi)^\top (R(\psi_i)^\top (p_j - p_i) - \Delta p);\ \mathrm{wrap}(\psi_j - \psi_i - \Delta\psi)] \f$.
+/// @param[out] J_e_xi if not null, \f$ \partial e / \partial [p_i; \psi_i] \f$ (3x3)
+/// @param[out] J_e_xj if not null, \f$ \partial e / \partial [p_j; \psi_j] \f$ (3x3)
+template <class Lazy = void>
+[[nodiscard]] Eigen::Vector3d edge_error_planar(const Eigen::Vector2d& pi, double yaw_i, const Eigen::Vector2d& pj,
+                                                double yaw_j, const Eigen::Vector2d& dp, double dyaw,
+                                                Eigen::Matrix3d* J_e_xi = nullptr,
+                                                Eigen::Matrix3d* J_e_xj = nullptr) {
+  return detail::edge_error_planar_trig(pi, yaw_i, std::cos(yaw_i), std::sin(yaw_i), pj, yaw_j, dp, dyaw,
+                                        std::cos(dyaw), std::sin(dyaw), J_e_xi, J_e_xj);
 }
 
 /// Why the optimiser stopped.
@@ -200,6 +256,10 @@ struct PoseGraphOptions {
   double gradient_tolerance = 1e-12;  ///< stop when \f$ \|J^\top W \Omega e\|_\infty < \mathrm{tol} \f$
   double parameter_tolerance = 1e-10;  ///< stop when \f$ \|\Delta\| < \mathrm{tol} (\|x\| + \mathrm{tol}) \f$
   double initial_lambda = 1e-5;       ///< LM damping \f$ \lambda \f$: \f$ H + \lambda\,\mathrm{diag}(H) \f$
+  /// Solve a planar graph (PoseGraph4Dof::is_planar()) on (x, y, yaw) with
+  /// 3x3 blocks instead of 4x4; the same iterations and optimum up to
+  /// rounding (the z rows decouple exactly), about 2x faster.
+  bool planar_fast_path = true;
 };
 
 /// What an optimisation did.
@@ -210,6 +270,7 @@ struct PoseGraphSummary {
   int accepted = 0;           ///< steps that decreased the cost
   Termination termination = Termination::kMaxIterations;  ///< why it stopped
   double solve_time_s = 0.0;  ///< wall time of optimize() (s)
+  bool planar = false;        ///< solved by the planar (3x3-block) path
 };
 
 /// A 4-DoF pose graph: nodes with unique ids, relative edges, fixed nodes.
@@ -219,6 +280,18 @@ struct PoseGraphSummary {
 /// order; ids are any std::int64_t values.
 class PoseGraph4Dof {
  public:
+  /// Reserves storage for `nodes` nodes and `edges` edges (optional; saves
+  /// the re-allocations of a graph built node by node).
+  void reserve(std::size_t nodes, std::size_t edges) {
+    ids_.reserve(nodes);
+    poses_.reserve(nodes);
+    Qt_.reserve(nodes);
+    fixed_.reserve(nodes);
+    index_.reserve(nodes);
+    edges_.reserve(edges);
+    ends_.reserve(edges);
+  }
+
   /// Adds a node.
   /// @param[in] id unique id
   /// @param[in] pose initial pose (roll and pitch stay fixed)
@@ -230,6 +303,7 @@ class PoseGraph4Dof {
       throw invalid_argument("pose graph: node " + std::to_string(id) + " has a non-finite pose");
     if (!index_.emplace(id, static_cast<int>(ids_.size())).second)
       throw invalid_argument("pose graph: duplicate node id " + std::to_string(id));
+    layout_valid_ = false;
     ids_.push_back(id);
     poses_.push_back(pose);
     poses_.back().yaw = wrap_angle(pose.yaw);
@@ -243,20 +317,24 @@ class PoseGraph4Dof {
   ///         the information is not finite, not symmetric or not positive
   ///         semi-definite, or a robust-loss scale is not finite and > 0
   std::size_t add_edge(const Edge4Dof& e) {
-    const std::string what = "pose graph: edge " + std::to_string(edges_.size()) + " (" +
-                             std::to_string(e.from) + " -> " + std::to_string(e.to) + ")";
+    // The message prefix is built only when an edge is refused.
+    const auto what = [&] {
+      return "pose graph: edge " + std::to_string(edges_.size()) + " (" + std::to_string(e.from) + " -> " +
+             std::to_string(e.to) + ")";
+    };
     const auto fi = index_.find(e.from);
     const auto ti = index_.find(e.to);
-    if (fi == index_.end()) throw invalid_argument(what + ": node " + std::to_string(e.from) + " does not exist");
-    if (ti == index_.end()) throw invalid_argument(what + ": node " + std::to_string(e.to) + " does not exist");
-    if (fi->second == ti->second) throw invalid_argument(what + ": both ends are the same node");
+    if (fi == index_.end()) throw invalid_argument(what() + ": node " + std::to_string(e.from) + " does not exist");
+    if (ti == index_.end()) throw invalid_argument(what() + ": node " + std::to_string(e.to) + " does not exist");
+    if (fi->second == ti->second) throw invalid_argument(what() + ": both ends are the same node");
     if (!e.dp.allFinite() || !std::isfinite(e.dyaw))
-      throw invalid_argument(what + ": the measurement is not finite");
-    if (!e.information.allFinite()) throw invalid_argument(what + ": the information matrix is not finite");
+      throw invalid_argument(what() + ": the measurement is not finite");
+    if (!e.information.allFinite()) throw invalid_argument(what() + ": the information matrix is not finite");
     if (!is_positive_semidefinite(e.information))
-      throw invalid_argument(what + ": the information matrix is not symmetric positive semi-definite");
+      throw invalid_argument(what() + ": the information matrix is not symmetric positive semi-definite");
     if (e.loss.type != RobustLoss::kNone && !(std::isfinite(e.loss.scale) && e.loss.scale > 0))
-      throw invalid_argument(what + ": the robust-loss scale must be finite and > 0");
+      throw invalid_argument(what() + ": the robust-loss scale must be finite and > 0");
+    layout_valid_ = false;
     edges_.push_back(e);
     ends_.emplace_back(fi->second, ti->second);
     return edges_.size() - 1;
@@ -264,7 +342,10 @@ class PoseGraph4Dof {
 
   /// Holds node `id` fixed (or frees it).
   /// @throws posefuse::invalid_argument when the node does not exist
-  void set_fixed(std::int64_t id, bool fixed = true) { fixed_[std::size_t(node_index(id))] = fixed ? 1 : 0; }
+  void set_fixed(std::int64_t id, bool fixed = true) {
+    fixed_[std::size_t(node_index(id))] = fixed ? 1 : 0;
+    layout_valid_ = false;
+  }
   /// True when node `id` is held fixed.
   [[nodiscard]] bool is_fixed(std::int64_t id) const { return fixed_[std::size_t(node_index(id))] != 0; }
   /// Number of nodes.
@@ -347,11 +428,11 @@ class PoseGraph4Dof {
   /// @throws posefuse::invalid_argument as validate(), or when a linear system is singular
   void initialize_rotation_first() {
     validate();
-    const Layout L = layout();
+    const Layout& L = layout();
     if (L.n == 0) return;
     // 1. Chordal yaw.
     {
-      detail::BlockSystem<2> sys;
+      detail::BlockSystem<2>& sys = workspace<2>().sys;  // reused buffers, see workspace()
       sys.build(L.n, L.pairs);
       sys.set_zero();
       for (std::size_t k = 0; k < edges_.size(); ++k) {
@@ -376,7 +457,7 @@ class PoseGraph4Dof {
     }
     // 2. Linear translation solve.
     {
-      detail::BlockSystem<3> sys;
+      detail::BlockSystem<3>& sys = workspace<3>().sys;
       sys.build(L.n, L.pairs);
       sys.set_zero();
       for (std::size_t k = 0; k < edges_.size(); ++k) {
@@ -415,122 +496,37 @@ class PoseGraph4Dof {
   PoseGraphSummary optimize(const PoseGraphOptions& options = {}) {
     const auto t0 = std::chrono::steady_clock::now();
     validate();
-    PoseGraphSummary s;
-    const Layout L = layout();
-    s.initial_cost = s.final_cost = cost();
-    if (L.n == 0 || edges_.empty()) {
-      s.termination = Termination::kGradientTolerance;
-      s.solve_time_s = seconds_since(t0);
-      return s;
-    }
-    detail::BlockSystem<4> sys;
-    sys.build(L.n, L.pairs);
-    detail::BlockCholesky<4> chol;
-    chol.analyze(sys);
-    double cost_now = s.initial_cost;
-    double lambda = options.levenberg_marquardt ? options.initial_lambda : 0.0;
-    double nu = 2.0;
-    bool relinearise = true;
-    Eigen::VectorXd diag;
-    std::vector<Pose4Dof> trial;
-    s.termination = Termination::kMaxIterations;
-    while (s.iterations < options.max_iterations) {
-      if (relinearise) {
-        assemble(sys);
-        diag = sys.diagonal();
-        if (sys.b.lpNorm<Eigen::Infinity>() < options.gradient_tolerance) {
-          s.termination = Termination::kGradientTolerance;
-          break;
-        }
-        relinearise = false;
-      }
-      ++s.iterations;
-      Eigen::VectorXd delta = Eigen::VectorXd::Zero(diag.size());
-      if (lambda > 0) {
-        for (Eigen::Index c = 0; c < diag.size(); ++c)
-          delta(c) = lambda * std::clamp(diag(c), 1e-6, 1e32);
-        sys.add_to_diagonal(delta);
-      }
-      const bool factored = chol.factorize(sys);
-      Eigen::VectorXd dx;
-      if (factored) dx = chol.solve(-sys.b);
-      if (lambda > 0) sys.add_to_diagonal(-delta);
-      if (!factored || !dx.allFinite()) {
-        if (!options.levenberg_marquardt) {
-          s.termination = Termination::kNoProgress;
-          break;
-        }
-        lambda = std::max(lambda, 1e-8) * nu;
-        nu *= 2;
-        if (lambda > 1e16) {
-          s.termination = Termination::kNoProgress;
-          break;
-        }
-        continue;
-      }
-      trial = poses_;
-      apply_step(L, dx, trial);
-      const double cost_new = cost_at(trial);
-      // Predicted decrease of the quadratic model of F = Σ ρ(s): -(2 Δᵀb + Δᵀ H Δ).
-      const double predicted = -(2.0 * dx.dot(sys.b) + sys.quadratic_form(dx));
-      // Near the minimum the cost change drops below its rounding error
-      // (F ~ 3 moves by 1e-20 when a pose moves by 1e-10): a step whose
-      // predicted decrease is at rounding level is taken once (the quadratic
-      // model is exact there) and the optimiser stops.
-      const double rounding = 64.0 * std::numeric_limits<double>::epsilon() * cost_now;
-      const bool polish = std::isfinite(cost_new) && !(cost_new < cost_now) && predicted >= 0 &&
-                          predicted <= rounding && cost_new <= cost_now + rounding;
-      if (polish) {
-        poses_.swap(trial);
-        ++s.accepted;
-        cost_now = std::min(cost_now, cost_new);
-        s.termination = Termination::kFunctionTolerance;
-        break;
-      }
-      if (std::isfinite(cost_new) && cost_new < cost_now) {
-        const double rho = predicted > 0 ? (cost_now - cost_new) / predicted : 1.0;
-        const double decrease = cost_now - cost_new;
-        poses_.swap(trial);
-        ++s.accepted;
-        relinearise = true;
-        if (options.levenberg_marquardt) {
-          const double f = 2.0 * rho - 1.0;
-          lambda *= std::max(1.0 / 3.0, 1.0 - f * f * f);
-          lambda = std::max(lambda, 1e-12);
-          nu = 2.0;
-        }
-        const double prev = cost_now;
-        cost_now = cost_new;
-        if (decrease < options.function_tolerance * prev) {
-          s.termination = Termination::kFunctionTolerance;
-          break;
-        }
-        if (dx.norm() < options.parameter_tolerance * (state_norm(L) + options.parameter_tolerance)) {
-          s.termination = Termination::kParameterTolerance;
-          break;
-        }
-      } else {
-        if (!options.levenberg_marquardt) {
-          s.termination = Termination::kNoProgress;
-          break;
-        }
-        // A step that does not lower the cost but is below the parameter
-        // tolerance means we are at the minimum to rounding.
-        if (dx.norm() < options.parameter_tolerance * (state_norm(L) + options.parameter_tolerance)) {
-          s.termination = Termination::kParameterTolerance;
-          break;
-        }
-        lambda *= nu;
-        nu *= 2;
-        if (lambda > 1e16) {
-          s.termination = Termination::kNoProgress;
-          break;
-        }
-      }
-    }
-    s.final_cost = cost_now;
+    PoseGraphSummary s = options.planar_fast_path && is_planar() ? optimize_blocks<3>(options)
+                                                                   : optimize_blocks<4>(options);
     s.solve_time_s = seconds_since(t0);
     return s;
+  }
+
+  /// Frees this thread's solver buffers. optimize() and
+  /// initialize_rotation_first() keep their arrays (the Cholesky factor above
+  /// all, about 1.4 MB for a 3 500-node planar graph) per thread between
+  /// calls, because paging fresh memory in cost as much as the solve itself
+  /// on a 1 000-node graph; call this to give the memory back.
+  static void release_workspace() {
+    workspace<2>() = Workspace<2>{};
+    workspace<3>() = Workspace<3>{};
+    workspace<4>() = Workspace<4>{};
+  }
+
+  /// True when the graph is planar: every node at z = 0 with no roll or
+  /// pitch, every edge with \f$ \Delta p_z = 0 \f$ and an information
+  /// matrix whose z row and column are zero off the diagonal (as
+  /// pose_graph_from_g2o builds). Then the z residuals are identically zero
+  /// and decouple from x, y and yaw, and optimize() may solve on (x, y, yaw).
+  [[nodiscard]] bool is_planar() const noexcept {
+    for (const Pose4Dof& x : poses_)
+      if (x.p.z() != 0.0 || x.roll != 0.0 || x.pitch != 0.0) return false;
+    for (const Edge4Dof& e : edges_) {
+      if (e.dp.z() != 0.0) return false;
+      for (int r = 0; r < 4; ++r)
+        if (r != 2 && (e.information(r, 2) != 0.0 || e.information(2, r) != 0.0)) return false;
+    }
+    return true;
   }
 
  private:
@@ -552,7 +548,17 @@ class PoseGraph4Dof {
     return f;
   }
 
-  [[nodiscard]] Layout layout() const {
+  /// The variable numbering (block AMD), computed once per graph structure
+  /// (the rotation-first start and optimize() share it).
+  [[nodiscard]] const Layout& layout() {
+    if (!layout_valid_) {
+      layout_ = compute_layout();
+      layout_valid_ = true;
+    }
+    return layout_;
+  }
+
+  [[nodiscard]] Layout compute_layout() const {
     Layout L;
     const std::vector<char> fixed = effective_fixed();
     std::vector<int> free_index(poses_.size(), -1);
@@ -579,7 +585,7 @@ class PoseGraph4Dof {
 
   template <int B>
   [[nodiscard]] static Eigen::VectorXd solve(detail::BlockSystem<B>& sys, const char* what) {
-    detail::BlockCholesky<B> chol;
+    detail::BlockCholesky<B>& chol = workspace<B>().chol;
     chol.analyze(sys);
     const bool factored = chol.factorize(sys);
     Eigen::VectorXd dx;
@@ -602,38 +608,291 @@ class PoseGraph4Dof {
     return F;
   }
 
-  void assemble(detail::BlockSystem<4>& sys) const {
-    sys.set_zero();
-    for (std::size_t k = 0; k < edges_.size(); ++k) {
-      const int i = ends_[k].first, j = ends_[k].second;
-      const Edge4Dof& ed = edges_[k];
-      Eigen::Matrix4d Ji, Jj;
-      const Eigen::Vector4d e =
-          edge_error_4dof(poses_[std::size_t(i)].p, poses_[std::size_t(i)].yaw, Qt_[std::size_t(i)],
-                          poses_[std::size_t(j)].p, poses_[std::size_t(j)].yaw, ed.dp, ed.dyaw, &Ji, &Jj);
-      const Eigen::Vector4d Oe = ed.information * e;
-      const double w = ed.loss.weight(e.dot(Oe));
-      const Eigen::Matrix4d WOJi = w * (ed.information * Ji);
-      const Eigen::Matrix4d WOJj = w * (ed.information * Jj);
-      sys.add(k, Ji.transpose() * WOJi, Ji.transpose() * WOJj, Jj.transpose() * WOJj,
-              w * (Ji.transpose() * Oe), w * (Jj.transpose() * Oe));
+  /// The optimiser's state of B per free-or-fixed node: [p; yaw] (B = 4)
+  /// or [x, y, yaw] (B = 3, planar).
+  template <int B>
+  using State = Eigen::Matrix<double, B, 1>;
+
+  /// Per-call buffers of optimize_blocks (capacity kept between calls of
+  /// one thread, see detail::graph_workspace).
+  template <int B>
+  struct Workspace {
+    detail::BlockSystem<B> sys;
+    detail::BlockCholesky<B> chol;
+    std::vector<State<B>> x, trial;
+    std::vector<double> c, s;             ///< cos / sin of each node's yaw
+    std::vector<double> cm, sm;           ///< cos / sin of each edge's Δψ
+    std::vector<Eigen::Matrix3d> info3;   ///< planar information (x, y, yaw)
+    Eigen::VectorXd diag, delta, dx;
+  };
+
+  /// One workspace per thread and block size: the solver's arrays (the
+  /// factor above all) keep their capacity from one optimize() call to the
+  /// next, so repeated calls do not page fresh memory in.
+  template <int B>
+  [[nodiscard]] static Workspace<B>& workspace() {
+    static thread_local Workspace<B> w;
+    return w;
+  }
+
+  template <int B>
+  void load_state(std::vector<State<B>>& x) const {
+    x.resize(poses_.size());
+    for (std::size_t a = 0; a < poses_.size(); ++a) {
+      if constexpr (B == 4) x[a] << poses_[a].p, poses_[a].yaw;
+      else x[a] << poses_[a].p.x(), poses_[a].p.y(), poses_[a].yaw;
     }
   }
 
-  void apply_step(const Layout& L, const Eigen::VectorXd& dx, std::vector<Pose4Dof>& x) const {
+  template <int B>
+  void store_state(const std::vector<State<B>>& x) {
+    for (std::size_t a = 0; a < poses_.size(); ++a) {
+      if constexpr (B == 4) poses_[a].p = x[a].template head<3>();
+      else poses_[a].p.template head<2>() = x[a].template head<2>();
+      poses_[a].yaw = x[a](B - 1);
+    }
+  }
+
+  template <int B>
+  static void node_trig(const std::vector<State<B>>& x, Workspace<B>& w) {
+    w.c.resize(x.size());
+    w.s.resize(x.size());
+    for (std::size_t a = 0; a < x.size(); ++a) {
+      w.c[a] = std::cos(x[a](B - 1));
+      w.s[a] = std::sin(x[a](B - 1));
+    }
+  }
+
+  /// Edge k's error (and Jacobians) at state x, node trigonometry in w.
+  template <int B>
+  State<B> edge_error_at(std::size_t k, const std::vector<State<B>>& x, const Workspace<B>& w,
+                         Eigen::Matrix<double, B, B>* Ji, Eigen::Matrix<double, B, B>* Jj) const {
+    const std::size_t i = std::size_t(ends_[k].first), j = std::size_t(ends_[k].second);
+    const Edge4Dof& ed = edges_[k];
+    if constexpr (B == 4) {
+      return detail::edge_error_4dof_trig(x[i].template head<3>(), x[i](3), w.c[i], w.s[i], Qt_[i],
+                                          x[j].template head<3>(), x[j](3), ed.dp, ed.dyaw, w.cm[k], w.sm[k], Ji, Jj);
+    } else {
+      return detail::edge_error_planar_trig(x[i].template head<2>(), x[i](2), w.c[i], w.s[i],
+                                            x[j].template head<2>(), x[j](2), ed.dp.template head<2>(), ed.dyaw,
+                                            w.cm[k], w.sm[k], Ji, Jj);
+    }
+  }
+
+  template <int B>
+  [[nodiscard]] const Eigen::Matrix<double, B, B>& edge_information(std::size_t k, const Workspace<B>& w) const {
+    if constexpr (B == 4) return edges_[k].information;
+    else return w.info3[k];
+  }
+
+  /// \f$ F \f$ at state x (node trigonometry recomputed into w).
+  template <int B>
+  [[nodiscard]] double cost_of(const std::vector<State<B>>& x, Workspace<B>& w) const {
+    node_trig<B>(x, w);
+    double F = 0.0;
+    for (std::size_t k = 0; k < edges_.size(); ++k) {
+      const State<B> e = edge_error_at<B>(k, x, w, nullptr, nullptr);
+      F += edges_[k].loss.rho(e.dot(edge_information<B>(k, w) * e));
+    }
+    return F;
+  }
+
+  /// H and b at state x (node trigonometry must be current in w).
+  ///
+  /// Uses the Jacobians' structure: \f$ J_j = \mathrm{diag}(A, 1) \f$ and
+  /// \f$ J_i = -J_j + \tilde g\, e_\psi^\top \f$ with \f$ \tilde g = [g; 0] \f$
+  /// the yaw column of \f$ \partial e_t / \partial \psi_i \f$. With
+  /// \f$ W = \rho'\Omega \f$, \f$ H_{jj} = J_j^\top W J_j \f$ and
+  /// \f$ u = J_j^\top W \tilde g \f$:
+  /// \f$ H_{ij} = -H_{jj} + e_\psi u^\top \f$,
+  /// \f$ H_{ii} = H_{jj} - u e_\psi^\top - e_\psi u^\top + (\tilde g^\top W \tilde g)\, e_\psi e_\psi^\top \f$,
+  /// \f$ b_i = -b_j + e_\psi (\tilde g^\top W e) \f$: one B x B triple
+  /// product per edge instead of five.
+  template <int B>
+  void assemble(const std::vector<State<B>>& x, Workspace<B>& w) const {
+    using Mat = Eigen::Matrix<double, B, B>;
+    constexpr int last = B - 1;
+    w.sys.set_zero();
+    for (std::size_t k = 0; k < edges_.size(); ++k) {
+      Mat Ji, Jj;
+      const State<B> e = edge_error_at<B>(k, x, w, &Ji, &Jj);
+      const Mat& Om = edge_information<B>(k, w);
+      const State<B> Oe = Om * e;
+      const double wt = edges_[k].loss.weight(e.dot(Oe));
+      State<B> g = Ji.col(last);
+      g(last) = 0.0;  // g~ = J_i's yaw column + J_j's
+      const Mat WJ = wt * (Om * Jj);
+      const Mat Hjj = Jj.transpose() * WJ;
+      const State<B> u = WJ.transpose() * g;
+      const double gWg = wt * g.dot(Om * g);
+      Mat Hij = -Hjj;
+      Hij.row(last) += u.transpose();
+      Mat Hii = Hjj;
+      Hii.col(last) -= u;
+      Hii.row(last) -= u.transpose();
+      Hii(last, last) += gWg;
+      const State<B> bj = wt * (Jj.transpose() * Oe);
+      State<B> bi = -bj;
+      bi(last) += wt * g.dot(Oe);
+      w.sys.add(k, Hii, Hij, Hjj, bi, bj);
+    }
+  }
+
+  template <int B>
+  static void apply_step(const Layout& L, const Eigen::VectorXd& dx, std::vector<State<B>>& x) {
     for (std::size_t a = 0; a < x.size(); ++a) {
       const int v = L.var[a];
       if (v < 0) continue;
-      x[a].p += dx.segment<3>(4 * v);
-      x[a].yaw = wrap_angle(x[a].yaw + dx(4 * v + 3));
+      x[a] += dx.template segment<B>(B * v);
+      x[a](B - 1) = wrap_angle(x[a](B - 1));
     }
   }
 
-  [[nodiscard]] double state_norm(const Layout& L) const {
+  template <int B>
+  [[nodiscard]] static double state_norm(const Layout& L, const std::vector<State<B>>& x) {
     double s = 0.0;
-    for (std::size_t a = 0; a < poses_.size(); ++a)
-      if (L.var[a] >= 0) s += poses_[a].p.squaredNorm() + poses_[a].yaw * poses_[a].yaw;
+    for (std::size_t a = 0; a < x.size(); ++a)
+      if (L.var[a] >= 0) s += x[a].squaredNorm();
     return std::sqrt(s);
+  }
+
+  /// optimize() on B x B blocks: B = 4 the general path, B = 3 the planar one.
+  template <int B>
+  PoseGraphSummary optimize_blocks(const PoseGraphOptions& options) {
+    Workspace<B>& w = workspace<B>();
+    PoseGraphSummary s;
+    s.planar = B == 3;
+    const std::size_t m = edges_.size();
+    w.cm.resize(m);
+    w.sm.resize(m);
+    for (std::size_t k = 0; k < m; ++k) {
+      w.cm[k] = std::cos(edges_[k].dyaw);
+      w.sm[k] = std::sin(edges_[k].dyaw);
+    }
+    if constexpr (B == 3) {
+      w.info3.resize(m);
+      const int map[3] = {0, 1, 3};
+      for (std::size_t k = 0; k < m; ++k)
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c) w.info3[k](r, c) = edges_[k].information(map[r], map[c]);
+    }
+    load_state<B>(w.x);
+    s.initial_cost = s.final_cost = cost_of<B>(w.x, w);  // leaves w.c, w.s at w.x
+    const Layout& L = layout();
+    if (L.n == 0 || edges_.empty()) {
+      s.termination = Termination::kGradientTolerance;
+      return s;
+    }
+    w.sys.build(L.n, L.pairs);
+    w.chol.analyze(w.sys);
+    double cost_now = s.initial_cost;
+    double lambda = options.levenberg_marquardt ? options.initial_lambda : 0.0;
+    double nu = 2.0;
+    bool relinearise = true;
+    s.termination = Termination::kMaxIterations;
+    const auto finish = [&] {
+      store_state<B>(w.x);
+      s.final_cost = cost_now;
+      return s;
+    };
+    while (s.iterations < options.max_iterations) {
+      if (relinearise) {
+        assemble<B>(w.x, w);
+        w.diag = w.sys.diagonal();
+        if (w.sys.b.template lpNorm<Eigen::Infinity>() < options.gradient_tolerance) {
+          s.termination = Termination::kGradientTolerance;
+          break;
+        }
+        relinearise = false;
+      }
+      ++s.iterations;
+      if (lambda > 0) {
+        w.delta.resize(w.diag.size());
+        for (Eigen::Index c = 0; c < w.diag.size(); ++c) w.delta(c) = lambda * std::clamp(w.diag(c), 1e-6, 1e32);
+        w.sys.add_to_diagonal(w.delta);
+      }
+      const bool factored = w.chol.factorize(w.sys);
+      if (factored) {
+        w.dx = -w.sys.b;
+        w.chol.solve_in_place(w.dx);
+      }
+      if (lambda > 0) w.sys.add_to_diagonal(-w.delta);
+      if (!factored || !w.dx.allFinite()) {
+        if (!options.levenberg_marquardt) {
+          s.termination = Termination::kNoProgress;
+          break;
+        }
+        lambda = std::max(lambda, 1e-8) * nu;
+        nu *= 2;
+        if (lambda > 1e16) {
+          s.termination = Termination::kNoProgress;
+          break;
+        }
+        continue;
+      }
+      const Eigen::VectorXd& dx = w.dx;
+      w.trial = w.x;
+      apply_step<B>(L, dx, w.trial);
+      const double cost_new = cost_of<B>(w.trial, w);  // w.c, w.s now at the trial
+      // Predicted decrease of the quadratic model of F = Σ ρ(s): -(2 Δᵀb + Δᵀ H Δ).
+      const double predicted = -(2.0 * dx.dot(w.sys.b) + w.sys.quadratic_form(dx));
+      // Near the minimum the cost change drops below its rounding error
+      // (F ~ 3 moves by 1e-20 when a pose moves by 1e-10): a step whose
+      // predicted decrease is at rounding level is taken once (the quadratic
+      // model is exact there) and the optimiser stops.
+      const double rounding = 64.0 * std::numeric_limits<double>::epsilon() * cost_now;
+      const bool polish = std::isfinite(cost_new) && !(cost_new < cost_now) && predicted >= 0 &&
+                          predicted <= rounding && cost_new <= cost_now + rounding;
+      if (polish) {
+        w.x.swap(w.trial);
+        ++s.accepted;
+        cost_now = std::min(cost_now, cost_new);
+        s.termination = Termination::kFunctionTolerance;
+        break;
+      }
+      if (std::isfinite(cost_new) && cost_new < cost_now) {
+        const double rho = predicted > 0 ? (cost_now - cost_new) / predicted : 1.0;
+        const double decrease = cost_now - cost_new;
+        w.x.swap(w.trial);  // the node trigonometry in w is the new state's
+        ++s.accepted;
+        relinearise = true;
+        if (options.levenberg_marquardt) {
+          const double f = 2.0 * rho - 1.0;
+          lambda *= std::max(1.0 / 3.0, 1.0 - f * f * f);
+          lambda = std::max(lambda, 1e-12);
+          nu = 2.0;
+        }
+        const double prev = cost_now;
+        cost_now = cost_new;
+        if (decrease < options.function_tolerance * prev) {
+          s.termination = Termination::kFunctionTolerance;
+          break;
+        }
+        if (dx.norm() < options.parameter_tolerance * (state_norm<B>(L, w.x) + options.parameter_tolerance)) {
+          s.termination = Termination::kParameterTolerance;
+          break;
+        }
+      } else {
+        node_trig<B>(w.x, w);  // back to the current state's trigonometry
+        if (!options.levenberg_marquardt) {
+          s.termination = Termination::kNoProgress;
+          break;
+        }
+        // A step that does not lower the cost but is below the parameter
+        // tolerance means we are at the minimum to rounding.
+        if (dx.norm() < options.parameter_tolerance * (state_norm<B>(L, w.x) + options.parameter_tolerance)) {
+          s.termination = Termination::kParameterTolerance;
+          break;
+        }
+        lambda *= nu;
+        nu *= 2;
+        if (lambda > 1e16) {
+          s.termination = Termination::kNoProgress;
+          break;
+        }
+      }
+    }
+    return finish();
   }
 
   std::vector<std::int64_t> ids_;
@@ -643,6 +902,8 @@ class PoseGraph4Dof {
   std::unordered_map<std::int64_t, int> index_;
   std::vector<Edge4Dof> edges_;
   std::vector<std::pair<int, int>> ends_;  ///< node indices of each edge
+  Layout layout_;                          ///< cached layout() (valid when layout_valid_)
+  bool layout_valid_ = false;
 };
 
 }  // namespace posefuse

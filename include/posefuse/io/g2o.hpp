@@ -32,6 +32,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <unordered_map>
 #include <string_view>
 #include <system_error>
 #include <vector>
@@ -138,12 +139,14 @@ void check_information(const M& info, const std::filesystem::path& file, std::si
 /// @return vertices, edges and fixed ids in file order
 /// @throws posefuse::io_error (file:line) for an unknown tag (the message
 ///         names it), a wrong number of fields, an unparsable number or id, a
-///         non-finite value or an information matrix that is not positive
+///         non-finite value, a vertex id defined twice (the message names
+///         the first line too) or an information matrix that is not positive
 ///         semi-definite; (file only) when the file cannot be read or has no vertex
 template <class Lazy = void>
 [[nodiscard]] G2oGraph2d read_g2o_2d(const std::filesystem::path& file) {
   namespace io = detail::g2o_io;
   G2oGraph2d g;
+  std::unordered_map<std::int64_t, std::size_t> vertex_line;  // id -> line of its VERTEX_SE2
   detail::LineReader reader(file);
   std::string line;
   while (reader.next(line)) {
@@ -160,7 +163,12 @@ template <class Lazy = void>
     if (tag == "VERTEX_SE2") {
       expect(5, "id x y theta");
       const std::vector<double> v = io::numbers(tok, 2, 3, file, n);
-      g.vertices.push_back({io::parse_id(tok[1], file, n, 2), v[0], v[1], v[2]});
+      const std::int64_t id = io::parse_id(tok[1], file, n, 2);
+      if (const auto [it, fresh] = vertex_line.emplace(id, n); !fresh)
+        throw io_error(file, n,
+                       "duplicate vertex id " + std::to_string(id) + " (first defined on line " +
+                           std::to_string(it->second) + ")");
+      g.vertices.push_back({id, v[0], v[1], v[2]});
     } else if (tag == "EDGE_SE2") {
       expect(12, "i j dx dy dtheta I11 I12 I13 I22 I23 I33");
       const std::vector<double> v = io::numbers(tok, 3, 9, file, n);

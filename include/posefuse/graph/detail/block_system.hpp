@@ -21,6 +21,7 @@
 #include <Eigen/OrderingMethods>
 #include <Eigen/SparseCore>
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <utility>
 #include <vector>
@@ -62,32 +63,61 @@ class BlockSystem {
   /// Builds the pattern. `pairs[k]` are the (already ordered) block columns
   /// of edge k's two ends, -1 for a fixed end.
   void build(int n, const std::vector<std::pair<int, int>>& pairs) {
+    // Two-pass CSR (counting sort by column, then by row within a column):
+    // no per-column vectors, and the arrays keep their capacity when the
+    // system is rebuilt, so a reused system allocates nothing.
     n_ = n;
-    std::vector<std::vector<int>> rows(static_cast<std::size_t>(n));
-    for (const auto& e : pairs) {
-      if (e.first < 0 || e.second < 0 || e.first == e.second) continue;
-      rows[std::size_t(std::max(e.first, e.second))].push_back(std::min(e.first, e.second));
-    }
+    const std::size_t m = pairs.size();
     colptr.assign(std::size_t(n) + 1, 0);
-    rowidx.clear();
-    for (int c = 0; c < n; ++c) {
-      std::vector<int>& r = rows[std::size_t(c)];
-      std::sort(r.begin(), r.end());
-      r.erase(std::unique(r.begin(), r.end()), r.end());
-      rowidx.insert(rowidx.end(), r.begin(), r.end());
-      colptr[std::size_t(c) + 1] = static_cast<int>(rowidx.size());
-    }
-    off.assign(rowidx.size(), Block::Zero());
-    diag.assign(std::size_t(n), Block::Zero());
-    slot_.assign(pairs.size(), -1);
-    for (std::size_t k = 0; k < pairs.size(); ++k) {
+    for (const auto& e : pairs)
+      if (e.first >= 0 && e.second >= 0 && e.first != e.second) ++colptr[std::size_t(std::max(e.first, e.second)) + 1];
+    for (int c = 0; c < n; ++c) colptr[std::size_t(c) + 1] += colptr[std::size_t(c)];
+    // Entries (row, edge) sorted by column, then by row through a second
+    // counting pass over the rows.
+    work_.assign(std::size_t(n) + 1, 0);
+    for (const auto& e : pairs)
+      if (e.first >= 0 && e.second >= 0 && e.first != e.second) ++work_[std::size_t(std::min(e.first, e.second)) + 1];
+    for (int r = 0; r < n; ++r) work_[std::size_t(r) + 1] += work_[std::size_t(r)];
+    by_row_.resize(std::size_t(colptr[std::size_t(n)]));
+    for (std::size_t k = 0; k < m; ++k) {
       const auto& e = pairs[k];
       if (e.first < 0 || e.second < 0 || e.first == e.second) continue;
-      const int lo = std::min(e.first, e.second), hi = std::max(e.first, e.second);
-      const auto first = rowidx.begin() + colptr[std::size_t(hi)];
-      const auto last = rowidx.begin() + colptr[std::size_t(hi) + 1];
-      slot_[k] = static_cast<int>(std::lower_bound(first, last, lo) - rowidx.begin());
+      by_row_[std::size_t(work_[std::size_t(std::min(e.first, e.second))]++)] = int(k);
     }
+    // Visiting edges in increasing row order and dropping each into its
+    // column keeps every column's rows sorted.
+    next_.assign(colptr.begin(), colptr.end() - 1);
+    rowidx.resize(by_row_.size());
+    slot_.assign(m, -1);
+    for (const int k : by_row_) {
+      const auto& e = pairs[std::size_t(k)];
+      const int lo = std::min(e.first, e.second), hi = std::max(e.first, e.second);
+      const int q = next_[std::size_t(hi)];
+      if (q > colptr[std::size_t(hi)] && rowidx[std::size_t(q) - 1] == lo) {
+        slot_[std::size_t(k)] = q - 1;  // a parallel edge: same block
+        continue;
+      }
+      rowidx[std::size_t(q)] = lo;
+      slot_[std::size_t(k)] = q;
+      ++next_[std::size_t(hi)];
+    }
+    // Compact the columns (parallel edges left gaps).
+    int w = 0;
+    remap_.resize(rowidx.size());
+    for (int c = 0; c < n; ++c) {
+      const int begin = colptr[std::size_t(c)], end = next_[std::size_t(c)];
+      colptr[std::size_t(c)] = w;
+      for (int q = begin; q < end; ++q) {
+        remap_[std::size_t(q)] = w;
+        rowidx[std::size_t(w++)] = rowidx[std::size_t(q)];
+      }
+    }
+    colptr[std::size_t(n)] = w;
+    rowidx.resize(std::size_t(w));
+    for (int& q : slot_)
+      if (q >= 0) q = remap_[std::size_t(q)];
+    off.resize(rowidx.size());
+    diag.resize(std::size_t(n));
     pairs_ = pairs;
     b.resize(n * B);
   }
@@ -151,6 +181,7 @@ class BlockSystem {
   int n_ = 0;
   std::vector<int> slot_;  ///< per edge: index of its off-diagonal block
   std::vector<std::pair<int, int>> pairs_;
+  std::vector<int> work_, by_row_, next_, remap_;  ///< build() scratch
 };
 
 /// Up-looking block sparse Cholesky \f$ H = L L^\top \f$ (see the file comment).
@@ -178,25 +209,28 @@ class BlockCholesky {
       }
     }
     // Column counts of L (strictly lower) from every row pattern.
-    std::vector<int> count(n, 0);
-    stack_.assign(n, 0);
+    Lp_.assign(n + 1, 0);
+    stack_.resize(n);
     mark_.assign(n, -1);
     for (int k = 0; k < n_; ++k) {
       const int top = ereach(sys, k);
-      for (int t = top; t < n_; ++t) ++count[std::size_t(stack_[std::size_t(t)])];
+      for (int t = top; t < n_; ++t) ++Lp_[std::size_t(stack_[std::size_t(t)]) + 1];
     }
-    Lp_.assign(n + 1, 0);
-    for (std::size_t c = 0; c < n; ++c) Lp_[c + 1] = Lp_[c] + count[c];
-    Li_.assign(std::size_t(Lp_[n]), 0);
-    Lx_.assign(std::size_t(Lp_[n]), Block::Zero());
-    Ldinv_.assign(n, Block::Zero());
+    for (std::size_t c = 0; c < n; ++c) Lp_[c + 1] += Lp_[c];
+    next_.resize(n);
+    // L's blocks are written by factorize() before they are read; only the
+    // accumulator x_ must start at zero (factorize() leaves it zero).
+    Li_.resize(std::size_t(Lp_[n]));
+    Lx_.resize(std::size_t(Lp_[n]));
+    Ldinv_.resize(n);
     x_.assign(n, Block::Zero());
   }
 
   /// Numeric factorisation of H (same pattern as analyzed).
   /// @return false when H is not (numerically) positive definite
   [[nodiscard]] bool factorize(const BlockSystem<B>& sys) {
-    std::vector<int> next(Lp_.begin(), Lp_.end() - 1);  // next free slot of each column
+    std::vector<int>& next = next_;  // next free slot of each column
+    std::copy(Lp_.begin(), Lp_.end() - 1, next.begin());
     for (int k = 0; k < n_; ++k) {
       const int top = ereach(sys, k);
       for (int p = sys.colptr[std::size_t(k)]; p < sys.colptr[std::size_t(k) + 1]; ++p)
@@ -214,18 +248,54 @@ class BlockCholesky {
         Li_[std::size_t(p)] = k;
         Lx_[std::size_t(p)] = y.transpose();
       }
-      const Eigen::LLT<Block> llt(d);
-      if (llt.info() != Eigen::Success) return false;
-      const Block L = llt.matrixL();
-      Ldinv_[std::size_t(k)] = L.template triangularView<Eigen::Lower>().solve(Block::Identity());
-      if (!Ldinv_[std::size_t(k)].allFinite()) return false;
+      if (!lower_cholesky_inverse(d, Ldinv_[std::size_t(k)])) {
+        for (Block& m : x_) m.setZero();  // leave the accumulator clean for the next call
+        return false;
+      }
     }
     return true;
+  }
+
+  /// \f$ L^{-1} \f$ of the lower Cholesky factor L of a symmetric B x B block
+  /// (the lower triangle of `d` is read), by the textbook column Cholesky
+  /// and forward substitution on the identity, fixed-size and unrolled.
+  /// @return false when a pivot is not positive and finite
+  [[nodiscard]] static bool lower_cholesky_inverse(const Block& d, Block& Linv) {
+    Block L = Block::Zero();
+    for (int j = 0; j < B; ++j) {
+      double s = d(j, j);
+      for (int p = 0; p < j; ++p) s -= L(j, p) * L(j, p);
+      if (!(s > 0.0) || !std::isfinite(s)) return false;
+      const double ljj = std::sqrt(s);
+      L(j, j) = ljj;
+      const double inv = 1.0 / ljj;
+      for (int i = j + 1; i < B; ++i) {
+        double t = d(i, j);
+        for (int p = 0; p < j; ++p) t -= L(i, p) * L(j, p);
+        L(i, j) = t * inv;
+      }
+    }
+    Linv.setZero();
+    for (int c = 0; c < B; ++c) {
+      Linv(c, c) = 1.0 / L(c, c);
+      for (int i = c + 1; i < B; ++i) {
+        double t = 0.0;
+        for (int p = c; p < i; ++p) t -= L(i, p) * Linv(p, c);
+        Linv(i, c) = t / L(i, i);
+      }
+    }
+    return Linv.allFinite();
   }
 
   /// \f$ H^{-1} r \f$ from the factor: \f$ L y = r \f$, then \f$ L^\top x = y \f$.
   [[nodiscard]] Eigen::VectorXd solve(const Eigen::VectorXd& r) const {
     Eigen::VectorXd y = r;
+    solve_in_place(y);
+    return y;
+  }
+
+  /// solve() overwriting its argument.
+  void solve_in_place(Eigen::VectorXd& y) const {
     for (int j = 0; j < n_; ++j) {
       const Vec yj = Ldinv_[std::size_t(j)] * y.template segment<B>(j * B);
       y.template segment<B>(j * B) = yj;
@@ -238,7 +308,6 @@ class BlockCholesky {
         yj.noalias() -= Lx_[std::size_t(p)].transpose() * y.template segment<B>(Li_[std::size_t(p)] * B);
       y.template segment<B>(j * B).noalias() = Ldinv_[std::size_t(j)].transpose() * yj;
     }
-    return y;
   }
 
   /// Number of strictly lower blocks of L.
@@ -270,7 +339,7 @@ class BlockCholesky {
   std::vector<Block> Lx_;
   std::vector<Block> Ldinv_;  ///< inverses of the diagonal blocks' lower Cholesky factors
   std::vector<Block> x_;   ///< work: the column being eliminated
-  std::vector<int> stack_, mark_, path_;
+  std::vector<int> stack_, mark_, path_, next_;
 };
 
 }  // namespace posefuse::detail
