@@ -58,6 +58,12 @@
 /// only the non-zero 3x3 blocks of P are stored (the bias-bias blocks stay
 /// scalar × I, Cov(θ, b_a) stays 0), the noise term has a closed form, and
 /// the result is converted to δφ when read (covariance(), bias_jacobian()).
+/// Position and velocity rows are stacked as 6x3 blocks so that their
+/// products vectorise with SSE2 (no -march flag is assumed), products by
+/// \f$ U_{b_g} \f$ go through V, and \f$ U_{b_a}U_{b_a}^\top \f$, \f$ VV^\top \f$ have
+/// closed forms. The step carries `[[gnu::flatten]]` (g++ and clang; other
+/// compilers ignore it): without it g++ leaves many of Eigen's small
+/// assignment kernels out of line and the step costs about 1.8x more.
 /// `DensePreintegration` in examples/apps/dense_preintegration.hpp forms the
 /// 15x15 F and 15x18 G in the δφ form and multiplies them (VINS-Mono's way);
 /// a test checks both agree to 1e-12.
@@ -92,15 +98,6 @@
 #include <posefuse/core/samples.hpp>
 #include <posefuse/core/time.hpp>
 #include <posefuse/lie/so3.hpp>
-
-// Inline every Eigen helper of the per-sample step into it (g++ and clang):
-// the step is ~40 small 3x3 products, and without this the compiler keeps
-// many of them as out-of-line calls, which costs about as much as the arithmetic.
-#if defined(__GNUC__) || defined(__clang__)
-#define POSEFUSE_INERTIAL_FLATTEN __attribute__((flatten))
-#else
-#define POSEFUSE_INERTIAL_FLATTEN
-#endif
 
 namespace posefuse {
 
@@ -215,11 +212,11 @@ void small_exp(const Eigen::Vector3d& theta, Eigen::Quaterniond& q, Eigen::Matri
   const double t2 = theta.squaredNorm();
   if (t2 < 0.05 * 0.05) {
     const double x2 = t2 / 4.0;  // (θ/2)²
-    const double c = 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0)));
-    const double k = 0.5 * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0 * (1.0 - x2 / 72.0))));
+    const double c = 1.0 - x2 * (1.0 / 2.0) * (1.0 - x2 * (1.0 / 12.0) * (1.0 - x2 * (1.0 / 30.0) * (1.0 - x2 * (1.0 / 56.0))));
+    const double k = 0.5 * (1.0 - x2 * (1.0 / 6.0) * (1.0 - x2 * (1.0 / 20.0) * (1.0 - x2 * (1.0 / 42.0) * (1.0 - x2 * (1.0 / 72.0)))));
     q = Eigen::Quaterniond(c, k * theta.x(), k * theta.y(), k * theta.z());
-    a = 0.5 * (1.0 - t2 / 12.0 * (1.0 - t2 / 30.0 * (1.0 - t2 / 56.0 * (1.0 - t2 / 90.0))));
-    b = (1.0 / 6.0) * (1.0 - t2 / 20.0 * (1.0 - t2 / 42.0 * (1.0 - t2 / 72.0 * (1.0 - t2 / 110.0))));
+    a = 0.5 * (1.0 - t2 * (1.0 / 12.0) * (1.0 - t2 * (1.0 / 30.0) * (1.0 - t2 * (1.0 / 56.0) * (1.0 - t2 * (1.0 / 90.0)))));
+    b = (1.0 / 6.0) * (1.0 - t2 * (1.0 / 20.0) * (1.0 - t2 * (1.0 / 42.0) * (1.0 - t2 * (1.0 / 72.0) * (1.0 - t2 * (1.0 / 110.0)))));
   } else {
     q = SO3d::exp(theta).quaternion();
     const double th = std::sqrt(t2);
@@ -238,7 +235,8 @@ void small_exp(const Eigen::Vector3d& theta, Eigen::Quaterniond& q, Eigen::Matri
 }
 
 /// \f$ -[u]_\times M \f$: the columns \f$ m_j \times u \f$ (27 flops instead of 45).
-inline Eigen::Matrix3d neg_skew_times(const Eigen::Vector3d& u, const Eigen::Matrix3d& M) noexcept {
+template <class Lazy = void>
+Eigen::Matrix3d neg_skew_times(const Eigen::Vector3d& u, const Eigen::Matrix3d& M) noexcept {
   Eigen::Matrix3d out;
   for (int j = 0; j < 3; ++j) {
     out(0, j) = M(1, j) * u.z() - M(2, j) * u.y();
@@ -248,14 +246,15 @@ inline Eigen::Matrix3d neg_skew_times(const Eigen::Vector3d& u, const Eigen::Mat
   return out;
 }
 
-/// \f$ M [u]_\times = M (-[u]_\times)^\top \f$: the rows \f$ (m_i \times u)^\top \f$.
-inline Eigen::Matrix3d times_skew(const Eigen::Matrix3d& M, const Eigen::Vector3d& u) noexcept {
-  Eigen::Matrix3d out;
-  for (int i = 0; i < 3; ++i) {
-    out(i, 0) = M(i, 1) * u.z() - M(i, 2) * u.y();
-    out(i, 1) = M(i, 2) * u.x() - M(i, 0) * u.z();
-    out(i, 2) = M(i, 0) * u.y() - M(i, 1) * u.x();
-  }
+/// \f$ M [u]_\times = M (-[u]_\times)^\top \f$ for an N x 3 matrix M, column by
+/// column (\f$ 6N \f$ flops; the columns vectorise when N is even).
+template <int N>
+Eigen::Matrix<double, N, 3> times_skew(const Eigen::Matrix<double, N, 3>& M,
+                                       const Eigen::Vector3d& u) noexcept {
+  Eigen::Matrix<double, N, 3> out;
+  out.col(0) = M.col(1) * u.z() - M.col(2) * u.y();
+  out.col(1) = M.col(2) * u.x() - M.col(0) * u.z();
+  out.col(2) = M.col(0) * u.y() - M.col(1) * u.x();
   return out;
 }
 
@@ -374,22 +373,22 @@ class Preintegration {
     const M3 Rt = R_.transpose();  // δφ = ΔR^T θ
     Covariance P = Covariance::Zero();
     P.block<3, 3>(0, 0) = C_.pp;
-    P.block<3, 3>(0, 3) = C_.pt * R_;
+    P.block<3, 3>(0, 3) = C_.qt.template topRows<3>() * R_;
     P.block<3, 3>(0, 6) = C_.pv;
     P.block<3, 3>(3, 3) = Rt * C_.tt * R_;
-    P.block<3, 3>(3, 6) = Rt * C_.tv;
+    P.block<3, 3>(3, 6) = Rt * C_.qt.template bottomRows<3>().transpose();
     P.block<3, 3>(6, 6) = C_.vv;
-    P.block<3, 3>(0, 9) = C_.pa;
-    P.block<3, 3>(0, 12) = C_.pg;
+    P.block<3, 3>(0, 9) = C_.qa.template topRows<3>();
+    P.block<3, 3>(0, 12) = C_.qg.template topRows<3>();
     P.block<3, 3>(3, 12) = Rt * C_.tg;
-    P.block<3, 3>(6, 9) = C_.va;
-    P.block<3, 3>(6, 12) = C_.vg;
+    P.block<3, 3>(6, 9) = C_.qa.template bottomRows<3>();
+    P.block<3, 3>(6, 12) = C_.qg.template bottomRows<3>();
     P.block<3, 3>(9, 9).diagonal().setConstant(C_.da);
     P.block<3, 3>(12, 12).diagonal().setConstant(C_.dg);
-    P.triangularView<Eigen::StrictlyLower>() = P.transpose();
+    P.template triangularView<Eigen::StrictlyLower>() = P.transpose();
     // The rotated diagonal block, symmetric to rounding: make it exact.
-    P.block<3, 3>(3, 3).triangularView<Eigen::StrictlyLower>() =
-        P.block<3, 3>(3, 3).transpose();
+    P.template block<3, 3>(3, 3).template triangularView<Eigen::StrictlyLower>() =
+        P.template block<3, 3>(3, 3).transpose();
     return P;
   }
   /// \f$ \partial[\Delta p, \Delta\phi, \Delta v] / \partial[b_a, b_g] \f$ at the
@@ -397,7 +396,8 @@ class Preintegration {
   template <class Lazy = void>
   [[nodiscard]] BiasJacobian bias_jacobian() const {
     BiasJacobian J;
-    J << Jp_a_, Jp_g_, M3::Zero(), R_.transpose() * Jt_g_, Jv_a_, Jv_g_;
+    J << Jq_a_.template topRows<3>(), Jq_g_.template topRows<3>(), M3::Zero(),
+        R_.transpose() * Jt_g_, Jq_a_.template bottomRows<3>(), Jq_g_.template bottomRows<3>();
     return J;
   }
   /// The linearisation bias \f$ \bar b \f$.
@@ -423,16 +423,19 @@ class Preintegration {
 
  private:
   using M3 = Eigen::Matrix3d;
+  using M63 = Eigen::Matrix<double, 6, 3>;
   // Internally the rotation error is the left perturbation in frame i,
   // ΔR_true = Exp(θ) ΔR, θ = ΔR δφ: its transition is the identity, the
   // accelerometer term is a cross product, and F has no E^T blocks. The
-  // covariance is kept as its non-zero 3x3 blocks (upper triangle; Cov(θ, b_a)
-  // stays 0, the bias-bias blocks are d_a I and d_g I) and converted to δφ
-  // when read.
+  // covariance is kept as its non-zero blocks, with p and v stacked as
+  // q = [p; v] where they share a column block (6x3: the products then
+  // vectorise with SSE2 packets of two). Cov(θ, b_a) stays 0, the bias-bias
+  // blocks are d_a I and d_g I; everything is converted to δφ when read.
   struct Blocks {
-    M3 pp, pt, pv, tt, tv, vv;  // Cov of [p, θ, v], upper blocks
-    M3 pa, pg, tg, va, vg;      // Cov([p, θ, v], [b_a, b_g]) without the zero θa block
-    double da, dg;              // bias variances (scalar × I)
+    M3 pp, pv, vv;   // Cov(q, q), upper blocks (pp, vv exactly symmetric)
+    M63 qt, qa, qg;  // Cov(q, θ), Cov(q, b_a), Cov(q, b_g)
+    M3 tt, tg;       // Cov(θ, θ) (exactly symmetric), Cov(θ, b_g)
+    double da, dg;   // bias variances (scalar × I)
   };
 
   void clear_state() {
@@ -440,23 +443,35 @@ class Preintegration {
     delta_v_.setZero();
     delta_q_.setIdentity();
     R_.setIdentity();
-    Jp_a_.setZero();
-    Jp_g_.setZero();
+    Jq_a_.setZero();
+    Jq_g_.setZero();
     Jt_g_.setZero();
-    Jv_a_.setZero();
-    Jv_g_.setZero();
-    for (M3* m : {&C_.pp, &C_.pt, &C_.pv, &C_.tt, &C_.tv, &C_.vv, &C_.pa, &C_.pg, &C_.tg, &C_.va,
-                  &C_.vg})
-      m->setZero();
+    for (M3* m : {&C_.pp, &C_.pv, &C_.vv, &C_.tt, &C_.tg}) m->setZero();
+    for (M63* m : {&C_.qt, &C_.qa, &C_.qg}) m->setZero();
     C_.da = C_.dg = 0.0;
     dt_s_ = 0.0;
   }
 
   [[nodiscard]] SO3d rotation() const { return SO3d(delta_q_); }
 
+  /// Copies the strict upper triangle of a 3x3 block to the lower one.
+  static void mirror_upper(M3& S) noexcept {
+    S(1, 0) = S(0, 1);
+    S(2, 0) = S(0, 2);
+    S(2, 1) = S(1, 2);
+  }
+
   /// One mid-point step (file comment) with the structured covariance and
   /// Jacobian update, in the left form described at Blocks.
-  POSEFUSE_INERTIAL_FLATTEN void integrate(const ImuSample& s0, const ImuSample& s1) {
+  ///
+  /// With q = [p; v], the step is q' = A q + B z, θ' = θ + w, the biases
+  /// unchanged, where A = [I, dt I; 0, I], B = [h I; dt I] (h = dt²/2),
+  /// z = δu = -[u]x θ + U_a δb_a + U_g δb_g (+ noise) and w = -V δb_g (+ noise),
+  /// V = ΔR_{k+1} J_r(ω̄ dt) dt, U_a = -(ΔR_k + ΔR_{k+1})/2, U_g = [c_1]x V / 2.
+  /// P' follows from the cross-covariances of z and w with the old state;
+  /// every product by U_g goes through V (U_g M^T = -½ [c_1]x V M^T), and
+  /// U_a U_a^T and V V^T have closed forms (both depend only on y = ΔR_{k+1} θ_step).
+  [[gnu::flatten]] void integrate(const ImuSample& s0, const ImuSample& s1) {
     const double dt = seconds_between(s1.t_ns, s0.t_ns);
     const double h = 0.5 * dt * dt;
     const Eigen::Vector3d a0 = s0.accel_mps2 - bias_.accel;
@@ -468,7 +483,10 @@ class Preintegration {
     const Eigen::Vector3d theta = w * dt;
     detail::small_exp(theta, E, Jr, ja, jb);
     const M3 R0 = R_;
-    delta_q_ = (delta_q_ * E).normalized();
+    delta_q_ = delta_q_ * E;
+    // Both factors are unit, so |q|² = 1 + ε with ε at rounding level: the
+    // first-order renormalisation (3 - |q|²)/2 = 1/|q| + O(ε²) needs no sqrt or division.
+    delta_q_.coeffs() *= 0.5 * (3.0 - delta_q_.squaredNorm());
     R_ = delta_q_.toRotationMatrix();
     const Eigen::Vector3d c0 = R0 * a0, c1 = R_ * a1;
     const Eigen::Vector3d u = 0.5 * (c0 + c1);
@@ -476,86 +494,94 @@ class Preintegration {
     delta_v_ += dt * u;
     dt_s_ += dt;
 
-    // δu = U_θ θ + U_a δb_a + U_g δb_g with U_θ = -[u]x (products by U_θ are
-    // cross products: detail::neg_skew_times / times_skew), θ' = θ - V δb_g.
-    const M3 Ua = -0.5 * (R0 + R_);
-    const M3 V = (R_ * Jr) * dt;
+    M3 Ua = R0 + R_;
+    Ua *= -0.5;
+    M3 V;
+    V.noalias() = R_ * Jr;
+    V *= dt;
     const M3 Ug = -0.5 * detail::neg_skew_times(c1, V);  // ½[c1]x V
 
-    // Bias Jacobians (J_θa = 0).
+    // Bias Jacobians (J_θa = 0): J_q' = A J_q + B U, J_θg' = J_θg - V.
     const M3 Zg = detail::neg_skew_times(u, Jt_g_) + Ug;
-    Jp_a_ += dt * Jv_a_ + h * Ua;
-    Jv_a_ += dt * Ua;
-    Jp_g_ += dt * Jv_g_ + h * Zg;
-    Jv_g_ += dt * Zg;
+    Jq_a_.template topRows<3>() += dt * Jq_a_.template bottomRows<3>() + h * Ua;
+    Jq_a_.template bottomRows<3>() += dt * Ua;
+    Jq_g_.template topRows<3>() += dt * Jq_g_.template bottomRows<3>() + h * Zg;
+    Jq_g_.template bottomRows<3>() += dt * Zg;
     Jt_g_ -= V;
 
-    // X = Cov(x', y) for the blocks needed, with z = δu and w = -V δb_g:
-    // X_p = P_p + dt P_v + h Cov(z, .), X_θ = P_θ + Cov(w, .), X_v = P_v + dt Cov(z, .).
-    Blocks& P = C_;
-    const M3 Czp = detail::neg_skew_times(u, P.pt.transpose()) + Ua * P.pa.transpose() +
-                   Ug * P.pg.transpose();
-    const M3 Czt = detail::neg_skew_times(u, P.tt) + Ug * P.tg.transpose();
-    const M3 Czv = detail::neg_skew_times(u, P.tv) + Ua * P.va.transpose() + Ug * P.vg.transpose();
-    const M3 Cza = P.da * Ua;
-    const M3 Czg = detail::neg_skew_times(u, P.tg) + P.dg * Ug;
-    const M3 Cwt = -V * P.tg.transpose();
-    const M3 Cwv = -V * P.vg.transpose();
-    const M3 Cwg = -P.dg * V;
-    const M3 Xpp = P.pp + dt * P.pv.transpose() + h * Czp;
-    const M3 Xpt = P.pt + dt * P.tv.transpose() + h * Czt;
-    const M3 Xpv = P.pv + dt * P.vv + h * Czv;
-    const M3 Xpa = P.pa + dt * P.va + h * Cza;
-    const M3 Xpg = P.pg + dt * P.vg + h * Czg;
-    const M3 Xtt = P.tt + Cwt;
-    const M3 Xtv = P.tv + Cwv;
-    const M3 Xtg = P.tg + Cwg;
-    const M3 Xvt = P.tv.transpose() + dt * Czt;
-    const M3 Xvv = P.vv + dt * Czv;
-    const M3 Xva = P.va + dt * Cza;
-    const M3 Xvg = P.vg + dt * Czg;
-    // P' = X (I + L)^T: Z_i = Cov(x'_i, z), W_i = Cov(x'_i, w).
-    const M3 Zp = detail::times_skew(Xpt, u) + Xpa * Ua.transpose() + Xpg * Ug.transpose();
-    const M3 Zt = detail::times_skew(Xtt, u) + Xtg * Ug.transpose();
-    const M3 Zv = detail::times_skew(Xvt, u) + Xva * Ua.transpose() + Xvg * Ug.transpose();
-    // Measurement noise, closed form (file comment), in the left form:
-    // Σθθ = ½c_g V V^T, Σuθ = -¼c_g [c1]x V V^T, Σuu = ½c_a I + c_g/8 [c1]x V V^T [c1]x^T,
-    // with V V^T = dt² R1 J_r J_r^T R1^T = dt² ((1 - c|y|²) I + c y y^T), y = R1 θ,
-    // c = 2b - a² - b²|θ|² (J_r J_r^T = I + c [θ]x², since [θ]x⁴ = -|θ|²[θ]x²).
-    const double ca = 2.0 * noise_.accel_noise_density * noise_.accel_noise_density / dt;
-    const double cg = 2.0 * noise_.gyro_noise_density * noise_.gyro_noise_density / dt;
+    // Closed forms, y = ΔR_{k+1} θ_step = ΔR_k θ_step:
+    // V V^T = dt² R1 J_r J_r^T R1^T = d0 I + d1 y y^T (J_r J_r^T = I + c [θ]x²,
+    // c = 2b - a² - b²|θ|², since [θ]x⁴ = -|θ|²[θ]x²);
+    // U_a U_a^T = ¼ R0 (2I + E + E^T) R0^T = (1 - ½a|θ|²) I + ½a y y^T;
+    // K = [c1]x V V^T = d0 [c1]x + d1 (c1 × y) y^T.
     const Eigen::Vector3d y = R_ * theta;
-    const double cj = 2.0 * jb - ja * ja - jb * jb * theta.squaredNorm();
+    const double t2 = theta.squaredNorm();
+    const double cj = 2.0 * jb - ja * ja - jb * jb * t2;
     const double d0 = dt * dt * (1.0 - cj * y.squaredNorm()), d1 = dt * dt * cj;
     const Eigen::Vector3d cy = c1.cross(y);
-    M3 Stt = (0.5 * cg * d1) * (y * y.transpose());
-    Stt.diagonal().array() += 0.5 * cg * d0;
-    // [c1]x V V^T = d0 [c1]x + d1 (c1 × y) y^T.
-    M3 Sut = (-0.25 * cg * d1) * (cy * y.transpose());
-    Sut(0, 1) += 0.25 * cg * d0 * c1.z();
-    Sut(1, 0) -= 0.25 * cg * d0 * c1.z();
-    Sut(0, 2) -= 0.25 * cg * d0 * c1.y();
-    Sut(2, 0) += 0.25 * cg * d0 * c1.y();
-    Sut(1, 2) += 0.25 * cg * d0 * c1.x();
-    Sut(2, 1) -= 0.25 * cg * d0 * c1.x();
-    // [c1]x V V^T [c1]x^T = d0 (|c1|² I - c1 c1^T) + d1 (c1 × y)(c1 × y)^T.
-    M3 Suu = (cg / 8.0) * (d1 * (cy * cy.transpose()) - d0 * (c1 * c1.transpose()));
-    Suu.diagonal().array() += 0.5 * ca + (cg / 8.0) * d0 * c1.squaredNorm();
+    const M3 yy = y * y.transpose();
+    M3 K = d1 * (cy * y.transpose());
+    K(0, 1) -= d0 * c1.z();
+    K(1, 0) += d0 * c1.z();
+    K(0, 2) += d0 * c1.y();
+    K(2, 0) -= d0 * c1.y();
+    K(1, 2) -= d0 * c1.x();
+    K(2, 1) += d0 * c1.x();
 
-    const M3 pp = Xpp + dt * Xpv + h * Zp + (h * h) * Suu;
-    const M3 tt = Xtt - Xtg * V.transpose() + Stt;
-    const M3 vv = Xvv + dt * Zv + (dt * dt) * Suu;
-    P.pp = 0.5 * (pp + pp.transpose());
-    P.pt = Xpt - Xpg * V.transpose() + h * Sut;
-    P.pv = Xpv + dt * Zp + (h * dt) * Suu;
-    P.tt = 0.5 * (tt + tt.transpose());
-    P.tv = Xtv + dt * Zt + dt * Sut.transpose();
-    P.vv = 0.5 * (vv + vv.transpose());
-    P.pa = Xpa;
-    P.pg = Xpg;
-    P.tg = Xtg;
-    P.va = Xva;
-    P.vg = Xvg;
+    // Cross-covariances of z and w with the old state.
+    Blocks& P = C_;
+    M63 Cqw;  // Cov(q, w) = -Cov(q, b_g) V^T
+    Cqw.noalias() = P.qg * V.transpose();
+    Cqw = -Cqw;
+    M3 Ctw;  // Cov(θ, w)
+    Ctw.noalias() = P.tg * V.transpose();
+    Ctw = -Ctw;
+    // Cov(q, z) = Cov(q, θ)[u]x + Cov(q, b_a) U_a^T + Cov(q, b_g) U_g^T, the last ½ Cov(q, w)[c1]x.
+    M63 Cqz = detail::times_skew<6>(P.qt, u) + 0.5 * detail::times_skew<6>(Cqw, c1);
+    Cqz.noalias() += P.qa * Ua.transpose();
+    // Cov(z, θ) = -[u]x Cov(θ, θ) + U_g Cov(b_g, θ), the last -½[c1]x Cov(w, θ).
+    const M3 Czt = detail::neg_skew_times(u, P.tt) + 0.5 * detail::neg_skew_times(c1, M3(Ctw.transpose()));
+    const M3 Cza = P.da * Ua;
+    const M3 Czg = detail::neg_skew_times(u, P.tg) + P.dg * Ug;
+    const M3 Czw = detail::neg_skew_times(u, Ctw) - (0.5 * P.dg) * K;
+    // Cov(z, z) = Cov(z, θ)[u]x + d_a U_a U_a^T + ½ Cov(z, w)[c1]x, plus the
+    // measurement noise (file comment), in the left form:
+    // Σθθ = ½c_g V V^T, Σuθ = -¼c_g K, Σuu = ½c_a I + c_g/8 K [c1]x^T.
+    const double two_over_dt = 2.0 / dt;
+    const double ca = two_over_dt * noise_.accel_noise_density * noise_.accel_noise_density;
+    const double cg = two_over_dt * noise_.gyro_noise_density * noise_.gyro_noise_density;
+    M3 Czz = detail::times_skew<3>(Czt, u) + detail::times_skew<3>(Czw, 0.5 * c1) +
+             (0.5 * P.da * ja) * yy + (cg / 8.0) * (d1 * (cy * cy.transpose()) - d0 * (c1 * c1.transpose()));
+    Czz.diagonal().array() +=
+        P.da * (1.0 - 0.5 * ja * t2) + 0.5 * ca + (cg / 8.0) * d0 * c1.squaredNorm();
+    mirror_upper(Czz);  // symmetric to rounding: make it exact
+    const M3 Sut = (-0.25 * cg) * K;
+
+    // Cov(q', q') = A Cov(q, q) A^T + M B^T + B M^T + B Czz B^T, M = A Cov(q, z).
+    const M3 Mp = Cqz.template topRows<3>() + dt * Cqz.template bottomRows<3>();
+    const M3 Mv = Cqz.template bottomRows<3>();
+    const M3 pvs = P.pv + P.pv.transpose();
+    P.pv += dt * P.vv + dt * Mp + h * Mv.transpose() + (h * dt) * Czz;
+    P.pp += dt * pvs + (dt * dt) * P.vv + h * (Mp + Mp.transpose()) + (h * h) * Czz;
+    P.vv += dt * (Mv + Mv.transpose()) + (dt * dt) * Czz;
+    mirror_upper(P.pp);
+    mirror_upper(P.vv);
+    // Cov(q', θ') = A (Cov(q, θ) + Cov(q, w)) + B (Cov(z, θ) + Cov(z, w) + Σuθ).
+    P.qt += Cqw;
+    const M3 Zt = Czt + Czw + Sut;
+    P.qt.template topRows<3>() += dt * P.qt.template bottomRows<3>() + h * Zt;
+    P.qt.template bottomRows<3>() += dt * Zt;
+    // Cov(q', b_a) = A Cov(q, b_a) + B d_a U_a; Cov(q', b_g) = A Cov(q, b_g) + B Cov(z, b_g).
+    P.qa.template topRows<3>() += dt * P.qa.template bottomRows<3>() + h * Cza;
+    P.qa.template bottomRows<3>() += dt * Cza;
+    P.qg.template topRows<3>() += dt * P.qg.template bottomRows<3>() + h * Czg;
+    P.qg.template bottomRows<3>() += dt * Czg;
+    // Cov(θ', θ') = Cov(θ, θ) + Cov(θ, w) + Cov(w, θ) + d_g V V^T + Σθθ; Cov(θ', b_g) = Cov(θ, b_g) - d_g V.
+    const double sv = P.dg + 0.5 * cg;
+    P.tt += Ctw + Ctw.transpose() + (sv * d1) * yy;
+    P.tt.diagonal().array() += sv * d0;
+    mirror_upper(P.tt);
+    P.tg -= P.dg * V;
     P.da += noise_.accel_random_walk * noise_.accel_random_walk * dt;
     P.dg += noise_.gyro_random_walk * noise_.gyro_random_walk * dt;
   }
@@ -566,8 +592,9 @@ class Preintegration {
   std::vector<ImuSample> samples_;
   Eigen::Vector3d delta_p_, delta_v_;
   Eigen::Quaterniond delta_q_;
-  M3 R_;                                     // ΔR as a matrix
-  M3 Jp_a_, Jp_g_, Jt_g_, Jv_a_, Jv_g_;      // bias Jacobians, θ rows in the left form
+  M3 R_;                 // ΔR as a matrix
+  M63 Jq_a_, Jq_g_;      // bias Jacobians of q = [Δp; Δv]
+  M3 Jt_g_;              // bias Jacobian of θ (left form)
   Blocks C_;
   double dt_s_ = 0.0;
 };
