@@ -544,6 +544,4 @@ TEST_CASE("Ekf fast paths: the expanded Joseph form of one- and two-row selectio
   CHECK(only_dense == 0);
   CHECK(both_applied > 1000);
   CHECK(compared > 20);
-  WARN("expanded Joseph vs dense Joseph on ill-conditioned priors: both applied " << both_applied
-       << ", only the fast path " << only_fast << ", only the dense path " << only_dense);
 }
