@@ -328,8 +328,9 @@ struct EkfOptions {
   static constexpr bool kRecordJacobian = true;
   /// Steady-state gain memo for time-invariant models (kTimeInvariant):
   /// keep the covariance half of the update and reuse it, bit for bit,
-  /// while P repeats. Cost: one Dim x Dim comparison per update and, per
-  /// model, a Dim x Dim copy of P whenever the gain is recomputed.
+  /// while P repeats (kept once the same P has been seen twice in a row).
+  /// Cost: one Dim x Dim comparison per update and, per model, a Dim x Dim
+  /// copy of P whenever P changed; the gain is copied once per new steady state.
   static constexpr bool kGainMemo = true;
 };
 
@@ -588,10 +589,12 @@ class BasicEkf {
     if constexpr (kSmallSelection<H>) {
       if constexpr (Options::kGainMemo && is_time_invariant_v<H>) {
         GainMemo<H>& memo = std::get<I>(memos_);
-        if (memo.valid && same_values(memo.P_in, P_))
-          return apply_update(sensor, z, gates_[I], gate, memo.gain);
-        memo.valid = false;
-        return small_selection_step(sensor, z, gates_[I], gate, &memo);
+        if (same_values(memo.P_in, P_)) {
+          if (memo.valid) return apply_update(sensor, z, gates_[I], gate, memo.gain);
+          return small_selection_step(sensor, z, gates_[I], gate, &memo);
+        }
+        remember_prior(memo);
+        return small_selection_step(sensor, z, gates_[I], gate, static_cast<GainMemo<H>*>(nullptr));
       } else {
         return small_selection_step(sensor, z, gates_[I], gate, static_cast<GainMemo<H>*>(nullptr));
       }
@@ -599,11 +602,16 @@ class BasicEkf {
       // The covariance part depends on P alone: reuse it while P repeats
       // (a converged, steady-state filter), bit for bit what it would compute.
       GainMemo<H>& memo = std::get<I>(memos_);
-      if (!memo.valid || !same_values(memo.P_in, P_)) {
-        memo.valid = false;
+      if (!same_values(memo.P_in, P_)) {
+        remember_prior(memo);
+        Gain<H> g;
+        const FilterStatus s = covariance_update(sensor, g);
+        if (s != FilterStatus::kApplied) return fail(UpdateResult<H>{}, s);
+        return apply_update(sensor, z, gates_[I], gate, g);
+      }
+      if (!memo.valid) {
         const FilterStatus s = covariance_update(sensor, memo.gain);
         if (s != FilterStatus::kApplied) return fail(UpdateResult<H>{}, s);
-        memo.P_in = P_;
         memo.valid = true;
       }
       return apply_update(sensor, z, gates_[I], gate, memo.gain);
@@ -626,12 +634,23 @@ class BasicEkf {
         Eigen::Matrix<Scalar, Dim, DimOf<typename H::Measurement>>::Zero();
     Covariance P_post = Covariance::Zero();
   };
+  /// The steady-state memo of one measurement model. A gain is kept only for
+  /// a prior P seen twice in a row: an update whose P differs from P_in just
+  /// records it (no gain copied, so a filter whose P keeps changing pays one
+  /// comparison and one copy of P per update); the next update with the same
+  /// P computes the gain into the memo; later ones with that P reuse it.
   template <class H>
   struct GainMemo {
-    bool valid = false;
-    Covariance P_in = Covariance::Zero();
+    bool valid = false;  ///< gain holds the update for P_in
+    Covariance P_in = Covariance::Constant(std::numeric_limits<Scalar>::quiet_NaN());
     Gain<H> gain;
   };
+  /// Records P as the memo's prior, with no gain yet.
+  template <class H>
+  [[gnu::always_inline]] void remember_prior(GainMemo<H>& memo) const noexcept {
+    memo.valid = false;
+    memo.P_in = P_;
+  }
 
   /// The state components a measurement model selects, when its Jacobian is
   /// a selection: H = I (kIdentityJacobian with Measurement::Dim == Dim) or
@@ -810,14 +829,13 @@ class BasicEkf {
     UpdateResult<H> out;
     for (int a = 0; a < M; ++a)
       for (int b = 0; b < M; ++b) out.S(a, b) = S[a][b];
-    if (memo) {
+    if (memo) {  // P_ is memo->P_in
       Gain<H>& g = memo->gain;
       g.S = out.S;
       g.S_solver.set_closed_form(inv, rd);
       for (int i = 0; i < Dim; ++i)
         for (int a = 0; a < M; ++a) g.K(i, a) = K[i][a];
       g.P_post = P_post;
-      memo->P_in = P_;
       memo->valid = true;
     }
     out.innovation = minus(z, static_cast<Z>(sensor.predict(x_)));
