@@ -289,7 +289,10 @@ enum class CovarianceUpdate : std::uint8_t {
   /// Joseph 1968; Grewal & Andrews, *Kalman Filtering*, 4th ed., eq. 4.23):
   /// PSD for any gain, so round-off in K does not make P indefinite. The
   /// default. Cost over kStandard: one Dim x Dim x M product more (one
-  /// triangle of it), e.g. +20 multiplications for Dim 4, M 2.
+  /// triangle of it), e.g. +20 multiplications for Dim 4, M 2. For a
+  /// selection H with one or two rows it is evaluated expanded, \f$ P - K H P
+  /// - P H^\top K^\top + K S K^\top \f$ (equal for a symmetric P; see
+  /// small_selection_step).
   kJoseph,
   /// The textbook \f$ (I - K H) P \f$ (one triangle, mirrored): fewer
   /// flops; exact only for the optimal gain, so round-off can leave P
