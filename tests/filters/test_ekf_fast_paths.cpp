@@ -491,3 +491,57 @@ TEST_CASE("is_positive_semidefinite: the minors (3x3, 4x4) and shifted-LDLT (abo
   check_shifted_psd_path<12>(rng);
   check_shifted_psd_path<15>(rng);
 }
+
+TEST_CASE("Ekf fast paths: the expanded Joseph form of one- and two-row selections keeps ill-conditioned "
+          "posteriors PSD wherever the dense Joseph form does",
+          "[filters][ekf][fast][psd]") {
+  // Priors with eigenvalues down to 1e-14 of the largest (rescaled rows and
+  // columns), measurement noise from 1e-12 to 1 of the prior's scale: the
+  // fast path (filters/ekf.hpp, small_selection_step) against the generic
+  // dense path. Every applied step must hold a PSD covariance, the fast path
+  // must apply every step the dense path applies, and where both apply and
+  // the problem is well-conditioned they agree to 1e-12.
+  std::mt19937 rng(97);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int both_applied = 0, only_fast = 0, only_dense = 0, compared = 0;
+  for (int draw = 0; draw < 2000; ++draw) {
+    const double r_scale = std::pow(10.0, -12.0 * u(rng));
+    const double sigma = std::sqrt(r_scale);
+    Ekf<ConstantVelocity2<double>, PositionFix<4>> fast(ConstantVelocity2<double>(1.0),
+                                                        PositionFix<4>::isotropic(sigma));
+    BasicEkf<NoMemo, HiddenMotion<ConstantVelocity2<double>>, HiddenSensor<PositionFix<4>>> dense(
+        {ConstantVelocity2<double>(1.0)}, {PositionFix<4>::isotropic(sigma)});
+    const double lo = std::pow(10.0, -14.0 * u(rng));
+    Eigen::Matrix4d P0 = random_spd<4>(rng, lo, 1.0, 1.0);
+    Eigen::Vector4d s;
+    for (int i = 0; i < 4; ++i) s(i) = std::exp(2.0 * n01(rng));
+    P0 = (s.asDiagonal() * P0 * s.asDiagonal()).eval();
+    P0 = (0.5 * (P0 + P0.transpose())).eval();
+    if (!is_positive_semidefinite(P0)) continue;
+    Eigen::Vector4d x0;
+    for (int i = 0; i < 4; ++i) x0(i) = n01(rng);
+    fast.reset(x0, P0);
+    dense.reset(x0, P0);
+    const double zx = n01(rng);
+    const double zy = n01(rng);
+    const Eigen::Vector2d z(zx, zy);
+    const bool a = fast.update<0>(z).status == FilterStatus::kApplied;
+    const bool b = dense.update<0>(z).status == FilterStatus::kApplied;
+    REQUIRE(is_positive_semidefinite(fast.covariance()));
+    REQUIRE(is_positive_semidefinite(dense.covariance()));
+    if (!a) REQUIRE(fast.covariance() == P0);
+    both_applied += a && b;
+    only_fast += a && !b;
+    only_dense += !a && b;
+    if (a && b && lo > 1e-3 && r_scale > 1e-3) {
+      ++compared;
+      require_same(fast, dense, 1e-12);
+    }
+  }
+  INFO("both applied " << both_applied << ", only fast " << only_fast << ", only dense "
+                       << only_dense << ", compared " << compared);
+  CHECK(only_dense == 0);
+  CHECK(both_applied > 1000);
+  CHECK(compared > 20);
+}

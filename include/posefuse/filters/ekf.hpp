@@ -144,13 +144,15 @@ class SpdSolver {
   [[nodiscard, gnu::always_inline]] bool compute(const Mat& S) {
     if constexpr (N == 1) {
       if (!(S(0, 0) > T(0))) return false;
-      inv_(0, 0) = T(1) / S(0, 0);
+      recip_ = T(1) / S(0, 0);
+      inv_(0, 0) = recip_;
       return true;
     } else if constexpr (N == 2) {
       const T det = S(0, 0) * S(1, 1) - S(0, 1) * S(1, 0);
       if (!(S(0, 0) > T(0) && det > T(2) * std::numeric_limits<T>::epsilon() * S(0, 0) * S(1, 1)))
         return false;
       const T r = T(1) / det;
+      recip_ = r;
       inv_(0, 0) = S(1, 1) * r;
       inv_(1, 1) = S(0, 0) * r;
       inv_(0, 1) = -S(0, 1) * r;
@@ -177,10 +179,28 @@ class SpdSolver {
       return true;
     }
   }
+  /// Sizes 1 and 2: sets the state compute() leaves for a positive definite
+  /// S, from \f$ S^{-1} \f$ and \f$ 1 / \det S \f$ computed as compute() does.
+  void set_closed_form(const T (&inv)[N][N], T recip) noexcept
+    requires(N <= 2)
+  {
+    for (int i = 0; i < N; ++i)
+      for (int j = 0; j < N; ++j) inv_(i, j) = inv[i][j];
+    recip_ = recip;
+  }
+  /// Sizes 1 and 2: \f$ 1 / \det S \f$ (S⁻¹ = adj(S) / det S), after compute().
+  [[nodiscard]] T recip_det() const noexcept
+    requires(N <= 2)
+  {
+    return recip_;
+  }
   /// \f$ r^\top S^{-1} r = \sum_j y_j^2 / d_j,\; y = L^{-1} r \f$.
   [[nodiscard, gnu::always_inline]] T nis(const Vec& r) const {
-    if constexpr (N <= 2) {
-      return r.dot(inv_ * r);
+    if constexpr (N == 1) {
+      return r(0) * (inv_(0, 0) * r(0));
+    } else if constexpr (N == 2) {
+      return r(0) * (inv_(0, 0) * r(0) + inv_(0, 1) * r(1)) +
+             r(1) * (inv_(1, 0) * r(0) + inv_(1, 1) * r(1));
     } else {
       Vec y;
       T sum = T(0);
@@ -244,6 +264,7 @@ class SpdSolver {
     }
   }
   [[no_unique_address]] Inverse inv_ = zero_inverse();
+  T recip_ = T(0);  // 1 / det S (sizes 1 and 2)
   [[no_unique_address]] Factor L_ = zero_factor();   // unit lower triangular L
   [[no_unique_address]] Factor LD_ = zero_factor();  // L_ij d_j (i > j)
   [[no_unique_address]] InvDiag inv_diag_ = zero_inv_diag();
@@ -268,7 +289,10 @@ enum class CovarianceUpdate : std::uint8_t {
   /// Joseph 1968; Grewal & Andrews, *Kalman Filtering*, 4th ed., eq. 4.23):
   /// PSD for any gain, so round-off in K does not make P indefinite. The
   /// default. Cost over kStandard: one Dim x Dim x M product more (one
-  /// triangle of it), e.g. +20 multiplications for Dim 4, M 2.
+  /// triangle of it), e.g. +20 multiplications for Dim 4, M 2. For a
+  /// selection H with one or two rows it is evaluated expanded, \f$ P - K H P
+  /// - P H^\top K^\top + K S K^\top \f$ (equal for a symmetric P; see
+  /// small_selection_step).
   kJoseph,
   /// The textbook \f$ (I - K H) P \f$ (one triangle, mirrored): fewer
   /// flops; exact only for the optimal gain, so round-off can leave P
@@ -307,8 +331,9 @@ struct EkfOptions {
   static constexpr bool kRecordJacobian = true;
   /// Steady-state gain memo for time-invariant models (kTimeInvariant):
   /// keep the covariance half of the update and reuse it, bit for bit,
-  /// while P repeats. Cost: one Dim x Dim comparison per update and, per
-  /// model, a Dim x Dim copy of P whenever the gain is recomputed.
+  /// while P repeats (kept once the same P has been seen twice in a row).
+  /// Cost: one Dim x Dim comparison per update and, per model, a Dim x Dim
+  /// copy of P whenever P changed; the gain is copied once per new steady state.
   static constexpr bool kGainMemo = true;
 };
 
@@ -403,7 +428,11 @@ class BasicEkf {
     [[maybe_unused]] Covariance F_new;  // recorded for the smoother (kRecordJacobian)
     if constexpr (has_identity_jacobian_v<Motion>) {
       x_new = motion_.predict(x_, u, dt);
+      // P is exactly symmetric, so P + Q is unless Q is not: mirror only then
+      // (the whole sum stays in vector registers otherwise).
       P_new = P_ + Covariance(motion_.noise(x_, u, dt));
+      if (!exactly_symmetric(P_new)) [[unlikely]]
+        mirror_lower(P_new);
     } else if constexpr (HasLinearize<Motion>) {
       // One model call (see HasLinearize, core/concepts.hpp).
       const auto lin = motion_.linearize(x_, u, dt);
@@ -425,9 +454,9 @@ class BasicEkf {
       if constexpr (Options::kRecordJacobian) F_new = F;
     }
     if (!finite(minus(x_new, x_))) return FilterStatus::kNonFinite;
-    mirror_lower(P_new);
+    if constexpr (!has_identity_jacobian_v<Motion>) mirror_lower(P_new);
     // Refuses NaN and Inf too; the finiteness pass runs only to name the failure.
-    if (!is_positive_semidefinite(P_new))
+    if (!psd_accepts(P_new))
       return P_new.allFinite() ? FilterStatus::kNotPositiveDefinite : FilterStatus::kNonFinite;
     if constexpr (Options::kRecordJacobian && !has_identity_jacobian_v<Motion>) F_ = F_new;
     x_ = x_new;
@@ -442,14 +471,15 @@ class BasicEkf {
   ///         kNotInitialised) and innovation statistics; the filter is
   ///         unchanged unless kApplied
   template <std::size_t I>
-  [[nodiscard]] UpdateResult<SensorType<I>> update(const typename SensorType<I>::Measurement& z) {
+  [[nodiscard, gnu::always_inline]] UpdateResult<SensorType<I>> update(
+      const typename SensorType<I>::Measurement& z) {
     return update_held<I>(z, NoGate{});
   }
 
   /// Update with the I-th measurement model, gated by its NIS gate *and* by
   /// `gate` (see InnovationGate; a number is a further NIS threshold).
   template <std::size_t I, InnovationGate<SensorType<I>> Gate>
-  [[nodiscard]] UpdateResult<SensorType<I>> update(const typename SensorType<I>::Measurement& z,
+  [[nodiscard, gnu::always_inline]] UpdateResult<SensorType<I>> update(const typename SensorType<I>::Measurement& z,
                                                    const Gate& gate) {
     return update_held<I>(z, gate);
   }
@@ -554,20 +584,37 @@ class BasicEkf {
 
   /// update<I>() with a gate (NoGate, a number or a functor) on top of gates_[I].
   template <std::size_t I, class Gate>
-  UpdateResult<SensorType<I>> update_held(const typename SensorType<I>::Measurement& z,
+  [[gnu::always_inline]] UpdateResult<SensorType<I>> update_held(const typename SensorType<I>::Measurement& z,
                                           const Gate& gate) {
     using H = SensorType<I>;
     if (!initialised_) return fail(UpdateResult<H>{}, FilterStatus::kNotInitialised);
     const H& sensor = std::get<I>(sensors_);
-    if constexpr (Options::kGainMemo && is_time_invariant_v<H>) {
+    if constexpr (kSmallSelection<H>) {
+      if constexpr (Options::kGainMemo && is_time_invariant_v<H>) {
+        GainMemo<H>& memo = std::get<I>(memos_);
+        if (same_values(memo.P_in, P_)) {
+          if (memo.valid) return apply_update(sensor, z, gates_[I], gate, memo.gain);
+          return small_selection_step(sensor, z, gates_[I], gate, &memo);
+        }
+        remember_prior(memo);
+        return small_selection_step(sensor, z, gates_[I], gate, static_cast<GainMemo<H>*>(nullptr));
+      } else {
+        return small_selection_step(sensor, z, gates_[I], gate, static_cast<GainMemo<H>*>(nullptr));
+      }
+    } else if constexpr (Options::kGainMemo && is_time_invariant_v<H>) {
       // The covariance part depends on P alone: reuse it while P repeats
       // (a converged, steady-state filter), bit for bit what it would compute.
       GainMemo<H>& memo = std::get<I>(memos_);
-      if (!memo.valid || !same_values(memo.P_in, P_)) {
-        memo.valid = false;
+      if (!same_values(memo.P_in, P_)) {
+        remember_prior(memo);
+        Gain<H> g;
+        const FilterStatus s = covariance_update(sensor, g);
+        if (s != FilterStatus::kApplied) return fail(UpdateResult<H>{}, s);
+        return apply_update(sensor, z, gates_[I], gate, g);
+      }
+      if (!memo.valid) {
         const FilterStatus s = covariance_update(sensor, memo.gain);
         if (s != FilterStatus::kApplied) return fail(UpdateResult<H>{}, s);
-        memo.P_in = P_;
         memo.valid = true;
       }
       return apply_update(sensor, z, gates_[I], gate, memo.gain);
@@ -590,12 +637,23 @@ class BasicEkf {
         Eigen::Matrix<Scalar, Dim, DimOf<typename H::Measurement>>::Zero();
     Covariance P_post = Covariance::Zero();
   };
+  /// The steady-state memo of one measurement model. A gain is kept only for
+  /// a prior P seen twice in a row: an update whose P differs from P_in just
+  /// records it (no gain copied, so a filter whose P keeps changing pays one
+  /// comparison and one copy of P per update); the next update with the same
+  /// P computes the gain into the memo; later ones with that P reuse it.
   template <class H>
   struct GainMemo {
-    bool valid = false;
-    Covariance P_in = Covariance::Zero();
+    bool valid = false;  ///< gain holds the update for P_in
+    Covariance P_in = Covariance::Constant(std::numeric_limits<Scalar>::quiet_NaN());
     Gain<H> gain;
   };
+  /// Records P as the memo's prior, with no gain yet.
+  template <class H>
+  [[gnu::always_inline]] void remember_prior(GainMemo<H>& memo) const noexcept {
+    memo.valid = false;
+    memo.P_in = P_;
+  }
 
   /// The state components a measurement model selects, when its Jacobian is
   /// a selection: H = I (kIdentityJacobian with Measurement::Dim == Dim) or
@@ -614,9 +672,224 @@ class BasicEkf {
     }
   }
 
+  /// covariance_update() for a selection H with one or two rows, on scalars
+  /// (kept in registers): S, then \f$ U = P H^\top \mathrm{adj}(S) \f$ and
+  /// \f$ W = U S U^\top \f$ while \f$ g = 1 / \det S \f$ is still being
+  /// divided, so that the division is the only step between S and the
+  /// posterior. \f$ K = g U \f$ (= P Hᵀ S⁻¹), and Joseph's form expanded for a
+  /// symmetric P, \f$ (I - K H) P (I - K H)^\top + K R K^\top = P - K H P - P
+  /// H^\top K^\top + K S K^\top \f$ (each term a function of the computed K,
+  /// so an error in K still enters only to second order), one triangle:
+  /// \f$ P^+_{ij} = P_{ij} - g\,(U_i \cdot B_j + B_i \cdot U_j) + g^2 W_{ij} \f$,
+  /// B = P Hᵀ. kStandard: \f$ P_{ij} - g\, U_i \cdot B_j \f$.
+  template <class H>
+  [[gnu::always_inline]] FilterStatus small_selection_update(const H& sensor, Gain<H>& g) const {
+    constexpr int M = DimOf<typename H::Measurement>;
+    constexpr std::array<int, std::size_t(M)> sel = selection<H>();
+    const auto R = measurement_noise(sensor, x_);
+    Scalar B[Dim][M];  // P H^T: the selected columns of P
+    for (int i = 0; i < Dim; ++i)
+      for (int a = 0; a < M; ++a) B[i][a] = P_(i, sel[std::size_t(a)]);
+    for (int a = 0; a < M; ++a)
+      for (int b = 0; b < M; ++b) g.S(a, b) = B[sel[std::size_t(a)]][b] + R(a, b);
+    // adj(S) (1x1: 1), and U = B adj(S), W = U S U^T, before the division.
+    Scalar U[Dim][M];
+    if constexpr (M == 1) {
+      for (int i = 0; i < Dim; ++i) U[i][0] = B[i][0];
+    } else {
+      for (int i = 0; i < Dim; ++i) {
+        U[i][0] = B[i][0] * g.S(1, 1) - B[i][1] * g.S(1, 0);
+        U[i][1] = B[i][1] * g.S(0, 0) - B[i][0] * g.S(0, 1);
+      }
+    }
+    if (!g.S_solver.compute(g.S)) return FilterStatus::kNotPositiveDefinite;
+    const Scalar rd = g.S_solver.recip_det();
+    for (int i = 0; i < Dim; ++i)
+      for (int a = 0; a < M; ++a) g.K(i, a) = rd * U[i][a];
+    if constexpr (Options::kCovarianceUpdate == CovarianceUpdate::kStandard) {
+      for (int j = 0; j < Dim; ++j)
+        for (int i = j; i < Dim; ++i) {
+          Scalar c = U[i][0] * B[j][0];
+          for (int a = 1; a < M; ++a) c += U[i][a] * B[j][a];
+          const Scalar v = P_(i, j) - rd * c;
+          g.P_post(i, j) = v;
+          g.P_post(j, i) = v;
+        }
+    } else {
+      Scalar V[Dim][M];  // U S
+      for (int i = 0; i < Dim; ++i)
+        for (int b = 0; b < M; ++b) {
+          Scalar v = U[i][0] * g.S(0, b);
+          for (int a = 1; a < M; ++a) v += U[i][a] * g.S(a, b);
+          V[i][b] = v;
+        }
+      const Scalar rd2 = rd * rd;
+      for (int j = 0; j < Dim; ++j)
+        for (int i = j; i < Dim; ++i) {
+          Scalar c = U[i][0] * B[j][0] + B[i][0] * U[j][0];
+          Scalar w = V[i][0] * U[j][0];
+          for (int a = 1; a < M; ++a) {
+            c += U[i][a] * B[j][a] + B[i][a] * U[j][a];
+            w += V[i][a] * U[j][a];
+          }
+          const Scalar v = (P_(i, j) - rd * c) + rd2 * w;
+          g.P_post(i, j) = v;
+          g.P_post(j, i) = v;
+        }
+    }
+    if (!psd_accepts(g.P_post))
+      return g.P_post.allFinite() ? FilterStatus::kNotPositiveDefinite : FilterStatus::kNonFinite;
+    return FilterStatus::kApplied;
+  }
+
+  /// Measurement models whose update takes small_selection_step().
+  template <class H>
+  static constexpr bool kSmallSelection = kSelects<H> && DimOf<typename H::Measurement> <= 2;
+
+  /// The whole update (covariance_update() + apply_update()) for a selection
+  /// H with one or two rows, on local scalars: the same formulas as
+  /// small_selection_update() and apply_update(), the same results and
+  /// diagnostics, without the intermediate Gain object. With a memo, fills it
+  /// as covariance_update() would.
+  template <class H, class Gate>
+  [[gnu::always_inline]] UpdateResult<H> small_selection_step(const H& sensor,
+                                                              const typename H::Measurement& z,
+                                                              Scalar nis_gate, const Gate& gate,
+                                                              GainMemo<H>* memo) {
+    using Z = typename H::Measurement;
+    using SMat = CovarianceOf<Z>;
+    constexpr int M = DimOf<Z>;
+    constexpr std::array<int, std::size_t(M)> sel = selection<H>();
+    const SMat R = measurement_noise(sensor, x_);
+    Scalar B[Dim][M];  // P H^T: the selected columns of P
+    for (int i = 0; i < Dim; ++i)
+      for (int a = 0; a < M; ++a) B[i][a] = P_(i, sel[std::size_t(a)]);
+    Scalar S[M][M];
+    for (int a = 0; a < M; ++a)
+      for (int b = 0; b < M; ++b) S[a][b] = B[sel[std::size_t(a)]][b] + R(a, b);
+    Scalar U[Dim][M];  // P H^T adj(S)
+    Scalar inv[M][M];  // S^-1 = adj(S) / det S
+    Scalar rd;
+    if constexpr (M == 1) {
+      for (int i = 0; i < Dim; ++i) U[i][0] = B[i][0];
+      if (!(S[0][0] > Scalar(0))) return fail(UpdateResult<H>{}, FilterStatus::kNotPositiveDefinite);
+      rd = Scalar(1) / S[0][0];
+      inv[0][0] = rd;
+    } else {
+      for (int i = 0; i < Dim; ++i) {
+        U[i][0] = B[i][0] * S[1][1] - B[i][1] * S[1][0];
+        U[i][1] = B[i][1] * S[0][0] - B[i][0] * S[0][1];
+      }
+      // detail::SpdSolver's criterion and closed form.
+      const Scalar det = S[0][0] * S[1][1] - S[0][1] * S[1][0];
+      if (!(S[0][0] > Scalar(0) &&
+            det > Scalar(2) * std::numeric_limits<Scalar>::epsilon() * S[0][0] * S[1][1]))
+        return fail(UpdateResult<H>{}, FilterStatus::kNotPositiveDefinite);
+      rd = Scalar(1) / det;
+      inv[0][0] = S[1][1] * rd;
+      inv[1][1] = S[0][0] * rd;
+      inv[0][1] = -S[0][1] * rd;
+      inv[1][0] = -S[1][0] * rd;
+    }
+    Scalar K[Dim][M];
+    for (int i = 0; i < Dim; ++i)
+      for (int a = 0; a < M; ++a) K[i][a] = rd * U[i][a];
+    Covariance P_post;
+    if constexpr (Options::kCovarianceUpdate == CovarianceUpdate::kStandard) {
+      for (int j = 0; j < Dim; ++j)
+        for (int i = j; i < Dim; ++i) {
+          Scalar c = U[i][0] * B[j][0];
+          for (int a = 1; a < M; ++a) c += U[i][a] * B[j][a];
+          const Scalar v = P_(i, j) - rd * c;
+          P_post(i, j) = v;
+          P_post(j, i) = v;
+        }
+    } else {
+      Scalar V[Dim][M];  // U S
+      for (int i = 0; i < Dim; ++i)
+        for (int b = 0; b < M; ++b) {
+          Scalar v = U[i][0] * S[0][b];
+          for (int a = 1; a < M; ++a) v += U[i][a] * S[a][b];
+          V[i][b] = v;
+        }
+      const Scalar rd2 = rd * rd;
+      for (int j = 0; j < Dim; ++j)
+        for (int i = j; i < Dim; ++i) {
+          Scalar c = U[i][0] * B[j][0] + B[i][0] * U[j][0];
+          Scalar w = V[i][0] * U[j][0];
+          for (int a = 1; a < M; ++a) {
+            c += U[i][a] * B[j][a] + B[i][a] * U[j][a];
+            w += V[i][a] * U[j][a];
+          }
+          const Scalar v = (P_(i, j) - rd * c) + rd2 * w;
+          P_post(i, j) = v;
+          P_post(j, i) = v;
+        }
+    }
+    if (!psd_accepts(P_post))
+      return fail(UpdateResult<H>{}, P_post.allFinite() ? FilterStatus::kNotPositiveDefinite
+                                                        : FilterStatus::kNonFinite);
+    UpdateResult<H> out;
+    for (int a = 0; a < M; ++a)
+      for (int b = 0; b < M; ++b) out.S(a, b) = S[a][b];
+    if (memo) {  // P_ is memo->P_in
+      Gain<H>& g = memo->gain;
+      g.S = out.S;
+      g.S_solver.set_closed_form(inv, rd);
+      for (int i = 0; i < Dim; ++i)
+        for (int a = 0; a < M; ++a) g.K(i, a) = K[i][a];
+      g.P_post = P_post;
+      memo->valid = true;
+    }
+    out.innovation = minus(z, static_cast<Z>(sensor.predict(x_)));
+    if (!finite(out.innovation)) return out;  // kNonFinite
+    if (needs_nis<H, Gate>(nis_gate)) {
+      // detail::SpdSolver::nis() for sizes 1 and 2, term for term.
+      const auto& r = out.innovation;
+      if constexpr (M == 1) {
+        out.nis = r(0) * (inv[0][0] * r(0));
+      } else {
+        out.nis = r(0) * (inv[0][0] * r(0) + inv[0][1] * r(1)) +
+                  r(1) * (inv[1][0] * r(0) + inv[1][1] * r(1));
+      }
+      if (!(out.nis <= nis_gate)) return fail(out, FilterStatus::kGated);
+    }
+    if (!gate_accepts<H>(gate, out)) return fail(out, FilterStatus::kGated);
+    TangentOf<StateType> dx;
+    for (int i = 0; i < Dim; ++i) {
+      Scalar v = K[i][0] * out.innovation(0);
+      for (int a = 1; a < M; ++a) v += K[i][a] * out.innovation(a);
+      dx(i) = v;
+    }
+    const StateType x_new = plus(x_, dx);
+    if (!finite(minus(x_new, x_))) return fail(out, FilterStatus::kNonFinite);
+    x_ = x_new;
+    P_ = P_post;
+    out.status = FilterStatus::kApplied;
+    return out;
+  }
+
+  /// is_positive_semidefinite(), with its fast path inlined for small sizes
+  /// and the reference out of line (same decisions).
+  [[gnu::always_inline]] static bool psd_accepts(const Covariance& P) {
+    if constexpr (Dim <= 4) {
+      if (detail::psd_fast_accepts(P)) [[likely]]
+        return true;
+      return psd_reference_cold(P);
+    } else {
+      return is_positive_semidefinite(P);
+    }
+  }
+  [[gnu::noinline, gnu::cold]] static bool psd_reference_cold(const Covariance& P) {
+    return detail::psd_reference(P, false);
+  }
+
   template <class H>
   [[gnu::always_inline]] FilterStatus covariance_update(const H& sensor, Gain<H>& g) const {
     constexpr int M = DimOf<typename H::Measurement>;
+    if constexpr (kSelects<H> && M <= 2) {
+      return small_selection_update(sensor, g);
+    }
     using SMat = typename Gain<H>::SMat;
     using HP = Eigen::Matrix<Scalar, M, Dim>;
     using Nm = Eigen::Matrix<Scalar, Dim, M>;
@@ -664,7 +937,7 @@ class BasicEkf {
     // scaled prior, rounding can still give a negative variance. Such a
     // result is refused (core/gaussian.hpp's criterion, which also refuses
     // NaN and Inf), never stored.
-    if (!is_positive_semidefinite(g.P_post))
+    if (!psd_accepts(g.P_post))
       return g.P_post.allFinite() ? FilterStatus::kNotPositiveDefinite : FilterStatus::kNonFinite;
     return FilterStatus::kApplied;
   }
@@ -686,7 +959,7 @@ class BasicEkf {
   }
 
   template <class H, class Gate>
-  [[gnu::always_inline]] UpdateResult<H> apply_update(const H& sensor, const typename H::Measurement& z, Scalar nis_gate,
+  [[gnu::always_inline, gnu::flatten]] UpdateResult<H> apply_update(const H& sensor, const typename H::Measurement& z, Scalar nis_gate,
                                const Gate& gate, const Gain<H>& g) {
     using Z = typename H::Measurement;
     UpdateResult<H> out;
@@ -744,6 +1017,13 @@ class BasicEkf {
     Scalar s = Scalar(0);
     for (int i = 0; i < N; ++i) s += v(i) - v(i);
     return s == Scalar(0);
+  }
+  /// True when every entry equals (==) its mirror image.
+  [[gnu::always_inline]] static bool exactly_symmetric(const Covariance& P) noexcept {
+    bool same = true;
+    for (int j = 0; j < Dim; ++j)
+      for (int i = j + 1; i < Dim; ++i) same &= P(i, j) == P(j, i);
+    return same;
   }
   /// Copies the lower triangle onto the upper one (exactly symmetric; no arithmetic).
   [[gnu::always_inline]] static void mirror_lower(Covariance& P) noexcept {
