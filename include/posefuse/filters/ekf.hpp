@@ -672,129 +672,64 @@ class BasicEkf {
     }
   }
 
-  /// covariance_update() for a selection H with one or two rows, on scalars
-  /// (kept in registers): S, then \f$ U = P H^\top \mathrm{adj}(S) \f$ and
-  /// \f$ W = U S U^\top \f$ while \f$ g = 1 / \det S \f$ is still being
-  /// divided, so that the division is the only step between S and the
-  /// posterior. \f$ K = g U \f$ (= P Hᵀ S⁻¹), and Joseph's form expanded for a
-  /// symmetric P, \f$ (I - K H) P (I - K H)^\top + K R K^\top = P - K H P - P
-  /// H^\top K^\top + K S K^\top \f$ (each term a function of the computed K,
-  /// so an error in K still enters only to second order), one triangle:
-  /// \f$ P^+_{ij} = P_{ij} - g\,(U_i \cdot B_j + B_i \cdot U_j) + g^2 W_{ij} \f$,
-  /// B = P Hᵀ. kStandard: \f$ P_{ij} - g\, U_i \cdot B_j \f$.
+  /// The covariance half of an update for a selection H with one or two
+  /// rows, on scalars (kept in registers): S, then \f$ U = P H^\top
+  /// \mathrm{adj}(S) \f$ and \f$ W = U S U^\top \f$ while \f$ g = 1 / \det S \f$ is
+  /// still being divided, so that the division is the only step between S
+  /// and the posterior. \f$ K = g U \f$ (= P Hᵀ S⁻¹), and Joseph's form
+  /// expanded for a symmetric P, \f$ (I - K H) P (I - K H)^\top + K R K^\top =
+  /// P - K H P - P H^\top K^\top + K S K^\top \f$ (each term a function of the
+  /// computed K, so an error in K still enters only to second order), one
+  /// triangle: \f$ P^+_{ij} = P_{ij} - g\,(U_i \cdot B_j + B_i \cdot U_j) + g^2
+  /// W_{ij} \f$, B = P Hᵀ. kStandard: \f$ P_{ij} - g\, U_i \cdot B_j \f$. The
+  /// positive-definiteness criterion of S and its closed-form inverse are
+  /// detail::SpdSolver's for sizes 1 and 2.
   template <class H>
-  [[gnu::always_inline]] FilterStatus small_selection_update(const H& sensor, Gain<H>& g) const {
-    constexpr int M = DimOf<typename H::Measurement>;
+  struct SmallSelection {
+    static constexpr int M = DimOf<typename H::Measurement>;
+    Scalar S[M][M];    ///< innovation covariance
+    Scalar inv[M][M];  ///< S⁻¹ = adj(S) / det S
+    Scalar rd;         ///< 1 / det S
+    Scalar K[Dim][M];  ///< gain
+    Covariance P_post;
+  };
+  template <class H>
+  [[gnu::always_inline]] FilterStatus small_selection_covariance(const H& sensor,
+                                                                 SmallSelection<H>& o) const {
+    constexpr int M = SmallSelection<H>::M;
     constexpr std::array<int, std::size_t(M)> sel = selection<H>();
     const auto R = measurement_noise(sensor, x_);
     Scalar B[Dim][M];  // P H^T: the selected columns of P
     for (int i = 0; i < Dim; ++i)
       for (int a = 0; a < M; ++a) B[i][a] = P_(i, sel[std::size_t(a)]);
-    for (int a = 0; a < M; ++a)
-      for (int b = 0; b < M; ++b) g.S(a, b) = B[sel[std::size_t(a)]][b] + R(a, b);
-    // adj(S) (1x1: 1), and U = B adj(S), W = U S U^T, before the division.
-    Scalar U[Dim][M];
-    if constexpr (M == 1) {
-      for (int i = 0; i < Dim; ++i) U[i][0] = B[i][0];
-    } else {
-      for (int i = 0; i < Dim; ++i) {
-        U[i][0] = B[i][0] * g.S(1, 1) - B[i][1] * g.S(1, 0);
-        U[i][1] = B[i][1] * g.S(0, 0) - B[i][0] * g.S(0, 1);
-      }
-    }
-    if (!g.S_solver.compute(g.S)) return FilterStatus::kNotPositiveDefinite;
-    const Scalar rd = g.S_solver.recip_det();
-    for (int i = 0; i < Dim; ++i)
-      for (int a = 0; a < M; ++a) g.K(i, a) = rd * U[i][a];
-    if constexpr (Options::kCovarianceUpdate == CovarianceUpdate::kStandard) {
-      for (int j = 0; j < Dim; ++j)
-        for (int i = j; i < Dim; ++i) {
-          Scalar c = U[i][0] * B[j][0];
-          for (int a = 1; a < M; ++a) c += U[i][a] * B[j][a];
-          const Scalar v = P_(i, j) - rd * c;
-          g.P_post(i, j) = v;
-          g.P_post(j, i) = v;
-        }
-    } else {
-      Scalar V[Dim][M];  // U S
-      for (int i = 0; i < Dim; ++i)
-        for (int b = 0; b < M; ++b) {
-          Scalar v = U[i][0] * g.S(0, b);
-          for (int a = 1; a < M; ++a) v += U[i][a] * g.S(a, b);
-          V[i][b] = v;
-        }
-      const Scalar rd2 = rd * rd;
-      for (int j = 0; j < Dim; ++j)
-        for (int i = j; i < Dim; ++i) {
-          Scalar c = U[i][0] * B[j][0] + B[i][0] * U[j][0];
-          Scalar w = V[i][0] * U[j][0];
-          for (int a = 1; a < M; ++a) {
-            c += U[i][a] * B[j][a] + B[i][a] * U[j][a];
-            w += V[i][a] * U[j][a];
-          }
-          const Scalar v = (P_(i, j) - rd * c) + rd2 * w;
-          g.P_post(i, j) = v;
-          g.P_post(j, i) = v;
-        }
-    }
-    if (!psd_accepts(g.P_post))
-      return g.P_post.allFinite() ? FilterStatus::kNotPositiveDefinite : FilterStatus::kNonFinite;
-    return FilterStatus::kApplied;
-  }
-
-  /// Measurement models whose update takes small_selection_step().
-  template <class H>
-  static constexpr bool kSmallSelection = kSelects<H> && DimOf<typename H::Measurement> <= 2;
-
-  /// The whole update (covariance_update() + apply_update()) for a selection
-  /// H with one or two rows, on local scalars: the same formulas as
-  /// small_selection_update() and apply_update(), the same results and
-  /// diagnostics, without the intermediate Gain object. With a memo, fills it
-  /// as covariance_update() would.
-  template <class H, class Gate>
-  [[gnu::always_inline]] UpdateResult<H> small_selection_step(const H& sensor,
-                                                              const typename H::Measurement& z,
-                                                              Scalar nis_gate, const Gate& gate,
-                                                              GainMemo<H>* memo) {
-    using Z = typename H::Measurement;
-    using SMat = CovarianceOf<Z>;
-    constexpr int M = DimOf<Z>;
-    constexpr std::array<int, std::size_t(M)> sel = selection<H>();
-    const SMat R = measurement_noise(sensor, x_);
-    Scalar B[Dim][M];  // P H^T: the selected columns of P
-    for (int i = 0; i < Dim; ++i)
-      for (int a = 0; a < M; ++a) B[i][a] = P_(i, sel[std::size_t(a)]);
-    Scalar S[M][M];
+    auto& S = o.S;
     for (int a = 0; a < M; ++a)
       for (int b = 0; b < M; ++b) S[a][b] = B[sel[std::size_t(a)]][b] + R(a, b);
     Scalar U[Dim][M];  // P H^T adj(S)
-    Scalar inv[M][M];  // S^-1 = adj(S) / det S
-    Scalar rd;
     if constexpr (M == 1) {
       for (int i = 0; i < Dim; ++i) U[i][0] = B[i][0];
-      if (!(S[0][0] > Scalar(0))) return fail(UpdateResult<H>{}, FilterStatus::kNotPositiveDefinite);
-      rd = Scalar(1) / S[0][0];
-      inv[0][0] = rd;
+      if (!(S[0][0] > Scalar(0))) return FilterStatus::kNotPositiveDefinite;
+      o.rd = Scalar(1) / S[0][0];
+      o.inv[0][0] = o.rd;
     } else {
       for (int i = 0; i < Dim; ++i) {
         U[i][0] = B[i][0] * S[1][1] - B[i][1] * S[1][0];
         U[i][1] = B[i][1] * S[0][0] - B[i][0] * S[0][1];
       }
-      // detail::SpdSolver's criterion and closed form.
       const Scalar det = S[0][0] * S[1][1] - S[0][1] * S[1][0];
       if (!(S[0][0] > Scalar(0) &&
             det > Scalar(2) * std::numeric_limits<Scalar>::epsilon() * S[0][0] * S[1][1]))
-        return fail(UpdateResult<H>{}, FilterStatus::kNotPositiveDefinite);
-      rd = Scalar(1) / det;
-      inv[0][0] = S[1][1] * rd;
-      inv[1][1] = S[0][0] * rd;
-      inv[0][1] = -S[0][1] * rd;
-      inv[1][0] = -S[1][0] * rd;
+        return FilterStatus::kNotPositiveDefinite;
+      o.rd = Scalar(1) / det;
+      o.inv[0][0] = S[1][1] * o.rd;
+      o.inv[1][1] = S[0][0] * o.rd;
+      o.inv[0][1] = -S[0][1] * o.rd;
+      o.inv[1][0] = -S[1][0] * o.rd;
     }
-    Scalar K[Dim][M];
+    const Scalar rd = o.rd;
     for (int i = 0; i < Dim; ++i)
-      for (int a = 0; a < M; ++a) K[i][a] = rd * U[i][a];
-    Covariance P_post;
+      for (int a = 0; a < M; ++a) o.K[i][a] = rd * U[i][a];
+    Covariance& P_post = o.P_post;
     if constexpr (Options::kCovarianceUpdate == CovarianceUpdate::kStandard) {
       for (int j = 0; j < Dim; ++j)
         for (int i = j; i < Dim; ++i) {
@@ -827,18 +762,57 @@ class BasicEkf {
         }
     }
     if (!psd_accepts(P_post))
-      return fail(UpdateResult<H>{}, P_post.allFinite() ? FilterStatus::kNotPositiveDefinite
-                                                        : FilterStatus::kNonFinite);
+      return P_post.allFinite() ? FilterStatus::kNotPositiveDefinite : FilterStatus::kNonFinite;
+    return FilterStatus::kApplied;
+  }
+
+  /// covariance_update() for a selection H with one or two rows:
+  /// small_selection_covariance() into a Gain.
+  template <class H>
+  [[gnu::always_inline]] FilterStatus small_selection_update(const H& sensor, Gain<H>& g) const {
+    SmallSelection<H> o;
+    const FilterStatus s = small_selection_covariance(sensor, o);
+    if (s != FilterStatus::kApplied) return s;
+    store_gain(o, g);
+    return FilterStatus::kApplied;
+  }
+  template <class H>
+  [[gnu::always_inline]] static void store_gain(const SmallSelection<H>& o, Gain<H>& g) noexcept {
+    constexpr int M = SmallSelection<H>::M;
+    for (int a = 0; a < M; ++a)
+      for (int b = 0; b < M; ++b) g.S(a, b) = o.S[a][b];
+    g.S_solver.set_closed_form(o.inv, o.rd);
+    for (int i = 0; i < Dim; ++i)
+      for (int a = 0; a < M; ++a) g.K(i, a) = o.K[i][a];
+    g.P_post = o.P_post;
+  }
+
+  /// Measurement models whose update takes small_selection_step().
+  template <class H>
+  static constexpr bool kSmallSelection = kSelects<H> && DimOf<typename H::Measurement> <= 2;
+
+  /// The whole update (covariance_update() + apply_update()) for a selection
+  /// H with one or two rows, on local scalars: small_selection_covariance()
+  /// and apply_update()'s formulas, the same results and diagnostics, without
+  /// the intermediate Gain object. With a memo, fills it as
+  /// covariance_update() would.
+  template <class H, class Gate>
+  [[gnu::always_inline]] UpdateResult<H> small_selection_step(const H& sensor,
+                                                              const typename H::Measurement& z,
+                                                              Scalar nis_gate, const Gate& gate,
+                                                              GainMemo<H>* memo) {
+    using Z = typename H::Measurement;
+    constexpr int M = DimOf<Z>;
+    SmallSelection<H> o;
+    const FilterStatus s = small_selection_covariance(sensor, o);
+    if (s != FilterStatus::kApplied) return fail(UpdateResult<H>{}, s);
+    const auto& inv = o.inv;
+    const auto& K = o.K;
     UpdateResult<H> out;
     for (int a = 0; a < M; ++a)
-      for (int b = 0; b < M; ++b) out.S(a, b) = S[a][b];
+      for (int b = 0; b < M; ++b) out.S(a, b) = o.S[a][b];
     if (memo) {  // P_ is memo->P_in
-      Gain<H>& g = memo->gain;
-      g.S = out.S;
-      g.S_solver.set_closed_form(inv, rd);
-      for (int i = 0; i < Dim; ++i)
-        for (int a = 0; a < M; ++a) g.K(i, a) = K[i][a];
-      g.P_post = P_post;
+      store_gain(o, memo->gain);
       memo->valid = true;
     }
     out.innovation = minus(z, static_cast<Z>(sensor.predict(x_)));
@@ -864,7 +838,7 @@ class BasicEkf {
     const StateType x_new = plus(x_, dx);
     if (!finite(minus(x_new, x_))) return fail(out, FilterStatus::kNonFinite);
     x_ = x_new;
-    P_ = P_post;
+    P_ = o.P_post;
     out.status = FilterStatus::kApplied;
     return out;
   }
