@@ -191,6 +191,25 @@ struct FourDofError {
   }
 };
 
+/// What both Ceres benchmarks report of a solve.
+struct CeresRun {
+  double chi2;     ///< g2o's chi² (twice Ceres's cost)
+  int iterations;  ///< LM iterations (Ceres counts iteration 0)
+};
+
+/// The Ceres settings of every comparison: sparse normal Cholesky, one
+/// thread, LM with function tolerance 1e-10, at most 100 iterations.
+CeresRun solve_with_ceres(ceres::Problem& problem) {
+  ceres::Solver::Options o;
+  o.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  o.max_num_iterations = 100;
+  o.function_tolerance = 1e-10;
+  o.num_threads = 1;
+  ceres::Solver::Summary summary;
+  ceres::Solve(o, &problem, &summary);
+  return {2.0 * summary.final_cost, static_cast<int>(summary.iterations.size()) - 1};
+}
+
 void BM_PoseGraph4Dof_ceres(benchmark::State& state) {
   const sim::PoseGraphProblem& pr = problem(static_cast<int>(state.range(0)));
   double chi2 = 0;
@@ -208,15 +227,9 @@ void BM_PoseGraph4Dof_ceres(benchmark::State& state) {
                                nullptr, x[std::size_t(e.from)].data(), x[std::size_t(e.to)].data());
     }
     problem.SetParameterBlockConstant(x[0].data());
-    ceres::Solver::Options o;
-    o.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-    o.max_num_iterations = 100;
-    o.function_tolerance = 1e-10;
-    o.num_threads = 1;
-    ceres::Solver::Summary summary;
-    ceres::Solve(o, &problem, &summary);
-    chi2 = 2.0 * summary.final_cost;
-    iterations = static_cast<int>(summary.iterations.size()) - 1;
+    const CeresRun run = solve_with_ceres(problem);
+    chi2 = run.chi2;
+    iterations = run.iterations;
     benchmark::DoNotOptimize(x.data());
   }
   state.counters["chi2"] = chi2;
@@ -291,15 +304,9 @@ void run_g2o_ceres(benchmark::State& state, bool from_file) {
                                nullptr, x[index.at(e.from)].data(), x[index.at(e.to)].data());
     }
     problem.SetParameterBlockConstant(x[0].data());
-    ceres::Solver::Options o;
-    o.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-    o.max_num_iterations = 100;
-    o.function_tolerance = 1e-10;
-    o.num_threads = 1;
-    ceres::Solver::Summary summary;
-    ceres::Solve(o, &problem, &summary);
-    chi2 = 2.0 * summary.final_cost;
-    iterations = static_cast<int>(summary.iterations.size()) - 1;
+    const CeresRun run = solve_with_ceres(problem);
+    chi2 = run.chi2;
+    iterations = run.iterations;
     benchmark::DoNotOptimize(x.data());
   }
   state.counters["chi2"] = chi2;

@@ -43,6 +43,16 @@ posefuse::sim::ImuSimConfig noise_free(double rate_hz) {
 
 double max_abs(const Eigen::Matrix<double, 9, 1>& e) { return e.cwiseAbs().maxCoeff(); }
 
+// Largest |P_ij - Pd_ij| relative to each entry's scale sqrt(Pd_ii Pd_jj).
+double normalised_difference(const Eigen::Matrix<double, 15, 15>& P,
+                             const Eigen::Matrix<double, 15, 15>& Pd) {
+  double worst = 0;
+  for (int i = 0; i < 15; ++i)
+    for (int j = 0; j < 15; ++j)
+      worst = std::max(worst, std::abs(P(i, j) - Pd(i, j)) / std::sqrt(Pd(i, i) * Pd(j, j)));
+  return worst;
+}
+
 }  // namespace
 
 TEST_CASE("Preintegration: noise-free simulation reproduces the relative motion",
@@ -163,11 +173,7 @@ TEST_CASE("Preintegration: the structured update equals the dense F P F^T + G Q 
   }
   const Eigen::Matrix<double, 15, 15> P = pre.covariance();
   const Eigen::Matrix<double, 15, 15> Pd = dense.covariance();
-  // Relative to each entry's scale sqrt(P_ii P_jj).
-  double worst = 0;
-  for (int i = 0; i < 15; ++i)
-    for (int j = 0; j < 15; ++j)
-      worst = std::max(worst, std::abs(P(i, j) - Pd(i, j)) / std::sqrt(Pd(i, i) * Pd(j, j)));
+  const double worst = normalised_difference(P, Pd);
   INFO("worst normalised covariance difference " << worst);
   CHECK(worst < 1e-12);
   CHECK((P - P.transpose()).cwiseAbs().maxCoeff() == 0.0);
@@ -207,10 +213,7 @@ TEST_CASE("Preintegration: structured equals dense over a long window with large
   REQUIRE(min_step < 0.05);
   const Eigen::Matrix<double, 15, 15> P = pre.covariance();
   const Eigen::Matrix<double, 15, 15> Pd = dense.covariance();
-  double worst = 0;
-  for (int i = 0; i < 15; ++i)
-    for (int j = 0; j < 15; ++j)
-      worst = std::max(worst, std::abs(P(i, j) - Pd(i, j)) / std::sqrt(Pd(i, i) * Pd(j, j)));
+  const double worst = normalised_difference(P, Pd);
   INFO("worst normalised covariance difference " << worst);
   CHECK(worst < 1e-12);
   CHECK((P - P.transpose()).cwiseAbs().maxCoeff() == 0.0);
