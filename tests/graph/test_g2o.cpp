@@ -103,6 +103,20 @@ TEST_CASE("g2o: malformed lines name file:line", "[graph][g2o]") {
   expect("VERTEX_SE2 0 0 0 0\nEDGE_SE2 0 1 1 0 0 1 2 0 1 0 1\n", "2:", "not positive semi-definite");
   expect("VERTEX_SE2 4 0 0 0\nVERTEX_SE2 5 1 0 0\n# again\nVERTEX_SE2 4 2 0 0\n", "4:",
          "duplicate vertex id 4 (first defined on line 1)");
+  expect("VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\nEDGE_SE2 1 1 0 0 0 1 0 0 1 0 1\n", "3:",
+         "edge from vertex 1 to itself");
+  // An edge may come before its vertices; a vertex no line defines is
+  // reported at the (first) line that names it, once the file is read.
+  expect("EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\nVERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\n"
+         "EDGE_SE2 1 7 1 0 0 1 0 0 1 0 1\n",
+         "4:", "vertex id 7 is not defined by any VERTEX_SE2 line");
+  expect("VERTEX_SE2 0 0 0 0\nFIX 0 3\n", "2:", "vertex id 3 is not defined");
+  CHECK_NOTHROW(read_g2o_2d(write_text(dir, "late.g2o",
+                                       "EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\nFIX 1\nVERTEX_SE2 0 0 0 0\n"
+                                       "VERTEX_SE2 1 1 0 0\n")));
+  const auto self = write_text(dir, "self.txt", "3 3 1 0 0 0 1 0 0 0 1 0 0 1 0 1\n");
+  CHECK_THROWS_WITH(read_loop_edges_4dof(self),
+                    Catch::Contains(self.string() + ":1:") && Catch::Contains("loop edge from node 3 to itself"));
   const auto empty = write_text(dir, "empty.g2o", "# nothing\n");
   CHECK_THROWS_WITH(read_g2o_2d(empty), Catch::Contains("no VERTEX_SE2"));
   const auto loops = write_text(dir, "loops.txt", "0 1 1 0 0 0 1 0 0 0 1 0 0 1 0 1\n0 1 1 0 0\n");
@@ -205,7 +219,7 @@ TEST_CASE("optimize_pose_graph: built-in graph, JSON, --out and errors", "[graph
   const auto bad = write_text(dir, "bad.g2o", "VERTEX_SE2 0 0 0 0\nEDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n");
   const auto missing = posefuse::test::run(exe, "--input '" + bad.string() + "'", dir);
   CHECK(missing.status == 1);
-  CHECK_THAT(missing.err, Catch::Contains("node 1 does not exist"));
+  CHECK_THAT(missing.err, Catch::Contains(bad.string() + ":2: vertex id 1 is not defined"));
   const auto split = write_text(dir, "split.g2o", "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 0 0 0\n");
   const auto disconnected = posefuse::test::run(exe, "--input '" + split.string() + "'", dir);
   CHECK(disconnected.status == 1);

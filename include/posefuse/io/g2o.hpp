@@ -32,9 +32,10 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
-#include <unordered_map>
 #include <string_view>
 #include <system_error>
+#include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include <posefuse/core/error.hpp>
@@ -140,13 +141,17 @@ void check_information(const M& info, const std::filesystem::path& file, std::si
 /// @throws posefuse::io_error (file:line) for an unknown tag (the message
 ///         names it), a wrong number of fields, an unparsable number or id, a
 ///         non-finite value, a vertex id defined twice (the message names
-///         the first line too) or an information matrix that is not positive
-///         semi-definite; (file only) when the file cannot be read or has no vertex
+///         the first line too), an edge from a vertex to itself, an edge or
+///         FIX naming an id no VERTEX_SE2 line defines (checked once the
+///         whole file is read: vertices may follow edges) or an information
+///         matrix that is not positive semi-definite; (file only) when the
+///         file cannot be read or has no vertex
 template <class Lazy = void>
 [[nodiscard]] G2oGraph2d read_g2o_2d(const std::filesystem::path& file) {
   namespace io = detail::g2o_io;
   G2oGraph2d g;
   std::unordered_map<std::int64_t, std::size_t> vertex_line;  // id -> line of its VERTEX_SE2
+  std::vector<std::pair<std::int64_t, std::size_t>> referenced;  // (id, line) of edge ends and FIX ids
   detail::LineReader reader(file);
   std::string line;
   while (reader.next(line)) {
@@ -175,6 +180,10 @@ template <class Lazy = void>
       G2oEdgeSE2 e;
       e.from = io::parse_id(tok[1], file, n, 2);
       e.to = io::parse_id(tok[2], file, n, 3);
+      if (e.from == e.to)
+        throw io_error(file, n, "edge from vertex " + std::to_string(e.from) + " to itself");
+      referenced.emplace_back(e.from, n);
+      referenced.emplace_back(e.to, n);
       e.dx = v[0];
       e.dy = v[1];
       e.dtheta = v[2];
@@ -183,7 +192,10 @@ template <class Lazy = void>
       g.edges.push_back(e);
     } else if (tag == "FIX") {
       if (tok.size() < 2) throw io_error(file, n, "FIX expects at least one node id");
-      for (std::size_t c = 1; c < tok.size(); ++c) g.fixed.push_back(io::parse_id(tok[c], file, n, c + 1));
+      for (std::size_t c = 1; c < tok.size(); ++c) {
+        g.fixed.push_back(io::parse_id(tok[c], file, n, c + 1));
+        referenced.emplace_back(g.fixed.back(), n);
+      }
     } else {
       throw io_error(file, n,
                      "unsupported g2o tag '" + std::string(tag) +
@@ -191,6 +203,9 @@ template <class Lazy = void>
     }
   }
   if (g.vertices.empty()) throw io_error(file, "no VERTEX_SE2 line");
+  for (const auto& [id, n] : referenced)
+    if (!vertex_line.count(id))
+      throw io_error(file, n, "vertex id " + std::to_string(id) + " is not defined by any VERTEX_SE2 line");
   return g;
 }
 
@@ -221,8 +236,9 @@ void write_g2o_2d(const std::filesystem::path& file, const G2oGraph2d& g) {
 
 /// Reads 4-DoF loop edges (format in the file comment).
 /// @throws posefuse::io_error (file:line) for a line without 16 fields, a
-///         bad id or number, or an information matrix that is not positive
-///         semi-definite; (file only) when it cannot be read
+///         bad id or number, an edge from a node to itself, or an
+///         information matrix that is not positive semi-definite; (file
+///         only) when it cannot be read
 template <class Lazy = void>
 [[nodiscard]] std::vector<LoopEdge4DofRecord> read_loop_edges_4dof(const std::filesystem::path& file) {
   namespace io = detail::g2o_io;
@@ -240,6 +256,8 @@ template <class Lazy = void>
     LoopEdge4DofRecord e;
     e.from = io::parse_id(tok[0], file, n, 1);
     e.to = io::parse_id(tok[1], file, n, 2);
+    if (e.from == e.to)
+      throw io_error(file, n, "loop edge from node " + std::to_string(e.from) + " to itself");
     const std::vector<double> v = io::numbers(tok, 2, 14, file, n);
     e.dp = Eigen::Vector3d(v[0], v[1], v[2]);
     e.dyaw = v[3];
