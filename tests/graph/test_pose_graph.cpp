@@ -487,3 +487,150 @@ TEST_CASE("PoseGraph4Dof: the planar path equals the 4-DoF path on a planar grap
   d.add_edge(e);
   CHECK_FALSE(d.is_planar());
 }
+
+namespace {
+
+/// H = sum J^T w Omega J and b = sum J^T w Omega e assembled densely, edge
+/// by edge, from edge_error_4dof's Jacobians (checked against central
+/// differences above), in the block order of `ids`; planar: the blocks are
+/// [x, y, yaw] (rows and columns 0, 1, 3 of the 4-DoF ones).
+std::pair<Eigen::MatrixXd, Eigen::VectorXd> dense_normal_equations(const PoseGraph4Dof& g,
+                                                                   const std::vector<Edge4Dof>& edges,
+                                                                   const std::vector<std::int64_t>& ids,
+                                                                   bool planar) {
+  const int B = planar ? 3 : 4;
+  const int map[4] = {0, 1, planar ? 3 : 2, 3};
+  const auto column = [&](std::int64_t id) {
+    const auto it = std::find(ids.begin(), ids.end(), id);
+    return it == ids.end() ? -1 : int(it - ids.begin());
+  };
+  const auto pose = [&](std::int64_t id) {
+    const auto it = std::find(g.ids().begin(), g.ids().end(), id);
+    return g.poses()[std::size_t(it - g.ids().begin())];
+  };
+  const int n = int(ids.size());
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(B * n, B * n);
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(B * n);
+  for (const Edge4Dof& e : edges) {
+    const Pose4Dof xi = pose(e.from), xj = pose(e.to);
+    Eigen::Matrix4d Ji, Jj;
+    const Eigen::Vector4d r = edge_error_4dof(xi.p, xi.yaw, roll_pitch_rotation(xi).transpose(), xj.p, xj.yaw,
+                                              e.dp, e.dyaw, &Ji, &Jj);
+    const Eigen::Matrix4d W = e.loss.weight(r.dot(e.information * r)) * e.information;
+    const int ci = column(e.from), cj = column(e.to);
+    const Eigen::Matrix4d* J[2] = {&Ji, &Jj};
+    const int c[2] = {ci, cj};
+    for (int s = 0; s < 2; ++s) {
+      if (c[s] < 0) continue;
+      const Eigen::Vector4d bs = J[s]->transpose() * W * r;
+      for (int u = 0; u < B; ++u) b(B * c[s] + u) += bs(map[u]);
+      for (int t = 0; t < 2; ++t) {
+        if (c[t] < 0) continue;
+        const Eigen::Matrix4d Hst = J[s]->transpose() * W * *J[t];
+        for (int u = 0; u < B; ++u)
+          for (int v = 0; v < B; ++v) H(B * c[s] + u, B * c[t] + v) += Hst(map[u], map[v]);
+      }
+    }
+  }
+  return {H, b};
+}
+
+double relative_difference(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return (a - b).cwiseAbs().maxCoeff() / std::max(1.0, b.cwiseAbs().maxCoeff());
+}
+
+}  // namespace
+
+TEST_CASE("PoseGraph4Dof: the assembled normal equations equal J^T W J from the checked Jacobians",
+          "[graph][jacobian][assembly]") {
+  // optimize() assembles H and b from the Jacobians' structure (J_i = -J_j +
+  // g e_yaw^T, one triple product per edge), not from the Jacobians
+  // themselves: compare with the dense sum over edges of J^T w Omega J, at a
+  // perturbed state with roll/pitch, correlated information and robust
+  // losses whose weights are below 1. A wrong sign or term in the assembly
+  // fails here.
+  std::mt19937 rng(11);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  TrueGraph t = make_true_graph(40, 4);
+  for (std::size_t k = 0; k < t.edges.size(); ++k) {
+    Edge4Dof& e = t.edges[k];
+    Eigen::Matrix4d A;
+    for (int r = 0; r < 4; ++r)
+      for (int c = 0; c < 4; ++c) A(r, c) = n01(rng);
+    e.information = A * A.transpose() + 0.1 * Eigen::Matrix4d::Identity();
+    e.dp += 0.2 * Eigen::Vector3d(n01(rng), n01(rng), n01(rng));
+    if (k % 3 == 1) e.loss = RobustKernel{RobustLoss::kCauchy, 0.5};
+    if (k % 3 == 2) e.loss = RobustKernel{RobustLoss::kHuber, 0.5};
+  }
+  PoseGraph4Dof g = perturbed(t, 9, 0.3, 0.2);
+  const NormalEquations ne = g.normal_equations();
+  REQUIRE(ne.block_size == 4);
+  REQUIRE(ne.ids.size() == 39);  // node 0 is fixed
+  const auto [H, b] = dense_normal_equations(g, t.edges, ne.ids, false);
+  INFO("H: " << relative_difference(ne.H, H) << ", b: " << relative_difference(ne.b, b));
+  CHECK(relative_difference(ne.H, H) < 1e-12);
+  CHECK(relative_difference(ne.b, b) < 1e-12);
+  // Some weights really are below 1, so the loss enters.
+  int down_weighted = 0;
+  for (const Edge4Dof& e : t.edges) {
+    const auto pose = [&](std::int64_t id) { return g.poses()[std::size_t(id)]; };
+    const Eigen::Vector4d r = edge_error_4dof(pose(e.from).p, pose(e.from).yaw,
+                                              roll_pitch_rotation(pose(e.from)).transpose(), pose(e.to).p,
+                                              pose(e.to).yaw, e.dp, e.dyaw);
+    if (e.loss.weight(r.dot(e.information * r)) < 0.9) ++down_weighted;
+  }
+  CHECK(down_weighted > 5);
+  CHECK_THROWS_AS(g.normal_equations(true), invalid_argument);  // roll/pitch: not planar
+}
+
+TEST_CASE("PoseGraph4Dof: the planar path's normal equations equal J^T W J on [x, y, yaw]",
+          "[graph][jacobian][assembly][planar]") {
+  std::mt19937 rng(12);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  PoseGraph4Dof g;
+  std::vector<Edge4Dof> edges;
+  const int n = 25;
+  for (int k = 0; k < n; ++k) {
+    Pose4Dof x;
+    x.p = Eigen::Vector3d(3.0 * n01(rng), 3.0 * n01(rng), 0.0);
+    x.yaw = wrap_angle(2.0 * n01(rng));
+    g.add_node(k, x, k == 0);
+  }
+  const auto add = [&](std::int64_t i, std::int64_t j, int k) {
+    Edge4Dof e;
+    e.from = i;
+    e.to = j;
+    e.dp = Eigen::Vector3d(n01(rng), n01(rng), 0.0);
+    e.dyaw = wrap_angle(n01(rng));
+    Eigen::Matrix3d A;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) A(r, c) = n01(rng);
+    const Eigen::Matrix3d I3 = A * A.transpose() + 0.1 * Eigen::Matrix3d::Identity();
+    e.information.setZero();
+    const int map[3] = {0, 1, 3};
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) e.information(map[r], map[c]) = I3(r, c);
+    e.information(2, 2) = 1.0;
+    if (k % 2 == 1) e.loss = RobustKernel{RobustLoss::kCauchy, 1.0};
+    g.add_edge(e);
+    edges.push_back(e);
+  };
+  int k = 0;
+  for (int i = 0; i + 1 < n; ++i) add(i, i + 1, k++);
+  for (int i = 5; i < n; i += 4) add(i - 5, i, k++);
+  REQUIRE(g.is_planar());
+  const NormalEquations ne = g.normal_equations(true);
+  REQUIRE(ne.block_size == 3);
+  const auto [H, b] = dense_normal_equations(g, edges, ne.ids, true);
+  INFO("H: " << relative_difference(ne.H, H) << ", b: " << relative_difference(ne.b, b));
+  CHECK(relative_difference(ne.H, H) < 1e-12);
+  CHECK(relative_difference(ne.b, b) < 1e-12);
+  // The 4-DoF system of the same graph holds the planar one (z decoupled).
+  const NormalEquations full = g.normal_equations();
+  REQUIRE(full.ids == ne.ids);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) {
+      const int map[3] = {0, 1, 3};
+      CHECK(full.H(map[r], map[c]) == Approx(ne.H(r, c)).epsilon(1e-12));
+    }
+}

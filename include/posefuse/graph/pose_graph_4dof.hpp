@@ -274,6 +274,14 @@ struct PoseGraphSummary {
   bool planar = false;        ///< solved by the planar (3x3-block) path
 };
 
+/// PoseGraph4Dof::normal_equations(): the Gauss–Newton system over the free nodes.
+struct NormalEquations {
+  Eigen::MatrixXd H;               ///< symmetric, B·n x B·n
+  Eigen::VectorXd b;               ///< gradient of the cost / 2
+  std::vector<std::int64_t> ids;   ///< node id of each block column
+  int block_size = 4;              ///< B: 4 ([x, y, z, yaw]) or 3 (planar [x, y, yaw])
+};
+
 /// A 4-DoF pose graph: nodes with unique ids, relative edges, fixed nodes.
 ///
 /// Usage: add_node for every pose, add_edge for every measurement, optionally
@@ -501,6 +509,23 @@ class PoseGraph4Dof {
                                                                    : optimize_blocks<4>(options);
     s.solve_time_s = seconds_since(t0);
     return s;
+  }
+
+  /// The Gauss–Newton system optimize() solves at the current poses (before
+  /// damping): \f$ H = \sum J^\top \rho' \Omega J \f$, \f$ b = \sum J^\top
+  /// \rho' \Omega e \f$ over the free nodes, dense. Block column c belongs to
+  /// node `ids[c]` (the solver's fill-reducing order); a block is
+  /// [x, y, z, yaw], or [x, y, yaw] with `planar` on a planar graph (the
+  /// planar path's system). Uses: covariance recovery on small graphs
+  /// (\f$ H^{-1} \f$ at the optimum), and checking the assembly against the
+  /// edges' Jacobians (tests).
+  /// @throws posefuse::invalid_argument as validate(), or when `planar` is
+  ///         asked of a graph that is not planar
+  [[nodiscard]] NormalEquations normal_equations(bool planar = false) {
+    validate();
+    if (!planar) return normal_equations_blocks<4>();
+    if (!is_planar()) throw invalid_argument("pose graph: normal_equations(planar) of a graph that is not planar");
+    return normal_equations_blocks<3>();
   }
 
   /// Frees this thread's solver buffers. optimize() and
@@ -758,11 +783,10 @@ class PoseGraph4Dof {
   }
 
   /// optimize() on B x B blocks: B = 4 the general path, B = 3 the planar one.
+  /// Per-edge constants of a solve: the trigonometry of each edge's Δψ and,
+  /// on the planar path, its (x, y, yaw) information.
   template <int B>
-  PoseGraphSummary optimize_blocks(const PoseGraphOptions& options) {
-    Workspace<B>& w = workspace<B>();
-    PoseGraphSummary s;
-    s.planar = B == 3;
+  void prepare_edges(Workspace<B>& w) const {
     const std::size_t m = edges_.size();
     w.cm.resize(m);
     w.sm.resize(m);
@@ -777,6 +801,34 @@ class PoseGraph4Dof {
         for (int r = 0; r < 3; ++r)
           for (int c = 0; c < 3; ++c) w.info3[k](r, c) = edges_[k].information(map[r], map[c]);
     }
+  }
+
+  template <int B>
+  NormalEquations normal_equations_blocks() {
+    Workspace<B> w;  // its own buffers: the thread's workspace is left alone
+    prepare_edges<B>(w);
+    load_state<B>(w.x);
+    node_trig<B>(w.x, w);
+    const Layout& L = layout();
+    NormalEquations out;
+    out.block_size = B;
+    out.ids.assign(std::size_t(L.n), 0);
+    for (std::size_t a = 0; a < poses_.size(); ++a)
+      if (L.var[a] >= 0) out.ids[std::size_t(L.var[a])] = ids_[a];
+    if (L.n == 0) return out;
+    w.sys.build(L.n, L.pairs);
+    assemble<B>(w.x, w);
+    out.H = w.sys.dense();
+    out.b = w.sys.b;
+    return out;
+  }
+
+  template <int B>
+  PoseGraphSummary optimize_blocks(const PoseGraphOptions& options) {
+    Workspace<B>& w = workspace<B>();
+    PoseGraphSummary s;
+    s.planar = B == 3;
+    prepare_edges<B>(w);
     load_state<B>(w.x);
     s.initial_cost = s.final_cost = cost_of<B>(w.x, w);  // leaves w.c, w.s at w.x
     const Layout& L = layout();

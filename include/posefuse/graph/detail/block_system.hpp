@@ -159,6 +159,19 @@ class BlockSystem {
   void add_to_diagonal(const Eigen::VectorXd& delta) {
     for (int c = 0; c < n_; ++c) diag[std::size_t(c)].diagonal() += delta.template segment<B>(c * B);
   }
+  /// H as a dense symmetric matrix (small systems: tests, covariances).
+  [[nodiscard]] Eigen::MatrixXd dense() const {
+    Eigen::MatrixXd H = Eigen::MatrixXd::Zero(n_ * B, n_ * B);
+    for (int c = 0; c < n_; ++c) {
+      H.template block<B, B>(c * B, c * B) = diag[std::size_t(c)];
+      for (int p = colptr[std::size_t(c)]; p < colptr[std::size_t(c) + 1]; ++p) {
+        const int r = rowidx[std::size_t(p)];
+        H.template block<B, B>(r * B, c * B) = off[std::size_t(p)];
+        H.template block<B, B>(c * B, r * B) = off[std::size_t(p)].transpose();
+      }
+    }
+    return H;
+  }
   /// \f$ x^\top H x \f$.
   [[nodiscard]] double quadratic_form(const Eigen::VectorXd& x) const {
     double q = 0.0;
