@@ -210,6 +210,17 @@ CeresRun solve_with_ceres(ceres::Problem& problem) {
   return {2.0 * summary.final_cost, static_cast<int>(summary.iterations.size()) - 1};
 }
 
+/// The counters and label of a Ceres row; the label warns when
+/// OMP_THREAD_LIMIT is not 1 (CHOLMOD would start threads).
+void report_ceres(benchmark::State& state, const CeresRun& run, std::string label) {
+  state.counters["chi2"] = run.chi2;
+  state.counters["iterations"] = run.iterations;
+  const char* limit = std::getenv("OMP_THREAD_LIMIT");
+  if (limit == nullptr || std::string(limit) != "1")
+    label += label.empty() ? "OMP_THREAD_LIMIT is not 1" : " OMP_THREAD_LIMIT is not 1";
+  if (!label.empty()) state.SetLabel(label);
+}
+
 void BM_PoseGraph4Dof_ceres(benchmark::State& state) {
   const sim::PoseGraphProblem& pr = problem(static_cast<int>(state.range(0)));
   double chi2 = 0;
@@ -232,10 +243,7 @@ void BM_PoseGraph4Dof_ceres(benchmark::State& state) {
     iterations = run.iterations;
     benchmark::DoNotOptimize(x.data());
   }
-  state.counters["chi2"] = chi2;
-  state.counters["iterations"] = iterations;
-  const char* limit = std::getenv("OMP_THREAD_LIMIT");
-  if (limit == nullptr || std::string(limit) != "1") state.SetLabel("OMP_THREAD_LIMIT is not 1");
+  report_ceres(state, {chi2, iterations}, "");
 }
 BENCHMARK(BM_PoseGraph4Dof_ceres)
     ->Name("BM_PoseGraph4Dof/ceres")
@@ -309,12 +317,7 @@ void run_g2o_ceres(benchmark::State& state, bool from_file) {
     iterations = run.iterations;
     benchmark::DoNotOptimize(x.data());
   }
-  state.counters["chi2"] = chi2;
-  state.counters["iterations"] = iterations;
-  std::string label = which == 0 ? "manhattan" : "mit";
-  const char* limit = std::getenv("OMP_THREAD_LIMIT");
-  if (limit == nullptr || std::string(limit) != "1") label += " OMP_THREAD_LIMIT is not 1";
-  state.SetLabel(label);
+  report_ceres(state, {chi2, iterations}, which == 0 ? "manhattan" : "mit");
 }
 void BM_G2o_ceres_file(benchmark::State& state) { run_g2o_ceres(state, true); }
 void BM_G2o_ceres_rotation_first(benchmark::State& state) { run_g2o_ceres(state, false); }
