@@ -9,7 +9,7 @@
 #include <apps/corridor_runner.hpp>
 #include <posefuse/fusion/gated_fuser.hpp>
 #include <posefuse/fusion/threshold_fuser.hpp>
-#include <apps/sim/corridor.hpp>
+#include <posefuse/sim/corridor.hpp>
 
 namespace {
 
@@ -111,7 +111,7 @@ void BM_FusePoses(benchmark::State& state) {
 
 // The whole comparison (four methods, both sensor chains, metrics) per log sample.
 void BM_CorridorRunner_PerSample(benchmark::State& state) {
-  const auto log = posefuse::simulate_corridor({}, 1).log;
+  const auto log = posefuse::sim::simulate_corridor({}, 1).log;
   const auto samples = std::int64_t(log.wheels.size() + log.imu.size() + log.slam.size());
   for (auto _ : state) benchmark::DoNotOptimize(posefuse::run_corridor(log));
   state.SetItemsProcessed(state.iterations() * samples);

@@ -1,5 +1,5 @@
 // bench_graph: 4-DoF pose-graph optimisation, posefuse against Ceres 2.1 on
-// the same seeded problems (examples/apps/sim/pose_graph_4dof.hpp: laps of a
+// the same seeded problems (include/posefuse/sim/pose_graph_4dof.hpp: laps of a
 // hilly track, odometry + a loop edge on every 4th pose, start = chained
 // odometry).
 //
@@ -53,7 +53,7 @@
 #include <random>
 #include <numbers>
 
-#include <apps/sim/pose_graph_4dof.hpp>
+#include <posefuse/sim/pose_graph_4dof.hpp>
 #include <posefuse/graph/g2o_graph.hpp>
 #include <posefuse/graph/pose_graph_4dof.hpp>
 #include <posefuse/io/g2o.hpp>

@@ -11,8 +11,8 @@
 #include <cstddef>
 #include <vector>
 
-#include <apps/dense_preintegration.hpp>
-#include <apps/sim/imu.hpp>
+#include <posefuse/testing/dense_preintegration.hpp>
+#include <posefuse/sim/imu.hpp>
 #include <array>
 
 #include <posefuse/inertial/alignment.hpp>
@@ -52,11 +52,11 @@ void BM_Preintegration_posefuse(benchmark::State& state) {
 
 void BM_Preintegration_dense(benchmark::State& state) {
   const std::vector<posefuse::ImuSample>& s = samples().samples;
-  posefuse::apps::DensePreintegration pre(posefuse::ImuNoise{}, posefuse::ImuBias{});
+  posefuse::testing::DensePreintegration pre(posefuse::ImuNoise{}, posefuse::ImuBias{});
   std::size_t k = 0;
   for (auto _ : state) {
     if (k == s.size()) {
-      pre = posefuse::apps::DensePreintegration(posefuse::ImuNoise{}, posefuse::ImuBias{});
+      pre = posefuse::testing::DensePreintegration(posefuse::ImuNoise{}, posefuse::ImuBias{});
       k = 0;
     }
     pre.add(s[k++]);

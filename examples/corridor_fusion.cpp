@@ -7,7 +7,7 @@
 // Four methods run on the same data: SLAM alone, odometry alone (wheels +
 // IMU, the seed's O_m), the seed's threshold fuser (eq 14-15 as printed) and
 // the gated fuser (covariance weighting, gates, re-anchoring). Without
-// --log it simulates the run (apps/sim/corridor.hpp documents every noise
+// --log it simulates the run (posefuse/sim/corridor.hpp documents every noise
 // figure); with --log DIR it runs on a recorded log folder (wheels.csv,
 // imu.csv, slam.csv, robot.txt, optional groundtruth.csv).
 //
@@ -52,7 +52,7 @@
 #include <apps/corridor_runner.hpp>
 #include <apps/json.hpp>
 #include <apps/output_file.hpp>
-#include <apps/sim/corridor.hpp>
+#include <posefuse/sim/corridor.hpp>
 #include <apps/svg.hpp>
 #include <posefuse/io/robot_log.hpp>
 
@@ -202,7 +202,7 @@ int run(const Options& o) {
     source = "log " + o.log->string();
   } else {
     const std::uint64_t seed = o.seed.value_or(1);
-    log = posefuse::simulate_corridor({}, seed).log;
+    log = posefuse::sim::simulate_corridor({}, seed).log;
     source = "simulation, seed " + std::to_string(seed);
   }
   const posefuse::CorridorRunResult r = posefuse::run_corridor(log);

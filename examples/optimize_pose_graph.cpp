@@ -42,7 +42,7 @@
 #include <apps/cli.hpp>
 #include <apps/json.hpp>
 #include <apps/output_file.hpp>
-#include <apps/sim/pose_graph_4dof.hpp>
+#include <posefuse/sim/pose_graph_4dof.hpp>
 #include <posefuse/core/error.hpp>
 #include <posefuse/eval/alignment.hpp>
 #include <posefuse/graph/g2o_graph.hpp>

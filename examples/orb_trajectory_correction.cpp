@@ -13,7 +13,7 @@
 //
 // With no arguments it runs on a built-in synthetic drive (a KITTI-06-like
 // 1.2 km loop with heading drift, scale error and 0.35 m position jitter;
-// examples/apps/sim/kitti_like_drive.hpp) and prints:
+// include/posefuse/sim/kitti_like_drive.hpp) and prints:
 //
 //   estimate     method    RMSE before [m]  RMSE after [m]  reduction   verdict
 //   synthetic    seed000             1.150           1.150     0.00 %   returns its input (SPEC.md A)
@@ -47,7 +47,7 @@
 #include <apps/cli.hpp>
 #include <apps/json.hpp>
 #include <apps/output_file.hpp>
-#include <apps/sim/kitti_like_drive.hpp>
+#include <posefuse/sim/kitti_like_drive.hpp>
 #include <apps/svg.hpp>
 #include <apps/trajectory_correction.hpp>
 #include <posefuse/eval/alignment.hpp>

@@ -3,7 +3,7 @@
 #include <limits>
 #include <posefuse/eval/metrics.hpp>
 #include <apps/trajectory_correction.hpp>
-#include <apps/sim/kitti_like_drive.hpp>
+#include <posefuse/sim/kitti_like_drive.hpp>
 
 using namespace posefuse;
 

@@ -14,7 +14,7 @@
 #include <unistd.h>
 #include <apps/corridor_runner.hpp>
 #include <posefuse/io/robot_log.hpp>
-#include <apps/sim/corridor.hpp>
+#include <posefuse/sim/corridor.hpp>
 
 namespace fs = std::filesystem;
 using posefuse::CorridorMethod;
@@ -52,7 +52,7 @@ TEST_CASE("Corridor: SLAM alone fails at corner 3; the gated fuser completes the
   int seed_fuser_flips = 0, gated_rmse_better = 0;
   double gated_lo = 1e9, gated_hi = 0, odom_lo = 1e9, odom_hi = 0;
   for (std::uint64_t seed = 1; seed <= 10; ++seed) {
-    const auto sim = posefuse::simulate_corridor({}, seed);
+    const auto sim = posefuse::sim::simulate_corridor({}, seed);
     const auto r = posefuse::run_corridor(sim.log);
     const auto& m = r.metrics;
     INFO("seed " << seed << ": loop closure slam " << m[kSlam].loop_closure_error_m << ", odom "
@@ -102,7 +102,7 @@ TEST_CASE("Corridor: SLAM alone fails at corner 3; the gated fuser completes the
 }
 
 TEST_CASE("Corridor: a written and re-read log gives identical numbers", "[fusion][corridor][io]") {
-  const auto sim = posefuse::simulate_corridor({}, 2);
+  const auto sim = posefuse::sim::simulate_corridor({}, 2);
   const fs::path dir = scratch_dir();
   posefuse::write_robot_log(dir, sim.log);
   const auto back = posefuse::read_robot_log(dir);
@@ -124,13 +124,13 @@ TEST_CASE("Corridor: a written and re-read log gives identical numbers", "[fusio
 
 TEST_CASE("Corridor: other rates and phases, a SLAM map that is not the world frame",
           "[fusion][corridor]") {
-  posefuse::CorridorSimConfig cfg;
+  posefuse::sim::CorridorSimConfig cfg;
   cfg.wheel_rate_hz = 37;  // no common multiples: every stream on its own clock
   cfg.imu_rate_hz = 113;
   cfg.slam_rate_hz = 9;
   cfg.truth_rate_hz = 71;
   cfg.jitter_s = 0.004;
-  auto sim = posefuse::simulate_corridor(cfg, 4);
+  auto sim = posefuse::sim::simulate_corridor(cfg, 4);
   {  // through a log folder, as a recorded log would come
     const fs::path dir = scratch_dir();
     posefuse::write_robot_log(dir, sim.log);
@@ -162,7 +162,7 @@ TEST_CASE("Corridor: other rates and phases, a SLAM map that is not the world fr
 
 TEST_CASE("Corridor: without ground truth the turns come from odometry, RMSE is NaN",
           "[fusion][corridor]") {
-  auto sim = posefuse::simulate_corridor({}, 5);
+  auto sim = posefuse::sim::simulate_corridor({}, 5);
   sim.log.groundtruth.clear();
   const auto r = posefuse::run_corridor(sim.log);
   CHECK_FALSE(r.turns_from_groundtruth);
@@ -177,7 +177,7 @@ TEST_CASE("Corridor: without ground truth the turns come from odometry, RMSE is 
 }
 
 TEST_CASE("Corridor: a log whose SLAM never tracks runs on odometry alone", "[fusion][corridor]") {
-  auto sim = posefuse::simulate_corridor({}, 6);
+  auto sim = posefuse::sim::simulate_corridor({}, 6);
   for (auto& s : sim.log.slam) s.state = posefuse::SlamState::kLost;
   const auto r = posefuse::run_corridor(sim.log);
   CHECK(r.tracks[kSlam].empty());
@@ -194,7 +194,7 @@ TEST_CASE("Corridor: a log whose SLAM never tracks runs on odometry alone", "[fu
 
 TEST_CASE("Corridor: camera-frame SLAM poses are a clear error naming slam.csv",
           "[fusion][corridor]") {
-  auto sim = posefuse::simulate_corridor({}, 2);
+  auto sim = posefuse::sim::simulate_corridor({}, 2);
   // Camera frame (x right, y down, z forward): positions (x, y, z) -> (-y, -z, x),
   // orientations rotated by +90 deg about x (the body's z axis is horizontal).
   const double h = std::sqrt(0.5);
@@ -220,7 +220,7 @@ TEST_CASE("Corridor: camera-frame SLAM poses are a clear error naming slam.csv",
 
 TEST_CASE("Corridor: a minority of tilted SLAM poses runs, counted and warned about",
           "[fusion][corridor]") {
-  auto sim = posefuse::simulate_corridor({}, 2);
+  auto sim = posefuse::sim::simulate_corridor({}, 2);
   const double h = std::sqrt(0.5);
   int tilted = 0, k = 0;
   for (auto& s : sim.log.slam) {
@@ -292,7 +292,7 @@ TEST_CASE("Corridor: a hand-written log folder with interleaved stamps is proces
 TEST_CASE("Corridor: a SLAM map that never matches odometry is warned about",
           "[fusion][corridor]") {
   // Non-metric (monocular) SLAM: positions at a third of the true scale.
-  auto sim = posefuse::simulate_corridor({}, 3);
+  auto sim = posefuse::sim::simulate_corridor({}, 3);
   for (auto& s : sim.log.slam) s.position_m /= 3.0;
   const auto r = posefuse::run_corridor(sim.log);
   INFO("anchors " << r.gated_anchors << ", fused " << r.gated_fused << " of " << r.slam_valid);
@@ -306,11 +306,11 @@ TEST_CASE("Corridor: an IMU that stops halfway falls back to the encoder heading
           "[fusion][corridor]") {
   // A clean magnetometer: half a log turns through only 180 deg, too little
   // for the calibration fit, and the yaw errors below are then the fallback's.
-  posefuse::CorridorSimConfig cfg;
+  posefuse::sim::CorridorSimConfig cfg;
   cfg.hard_iron_sigma_uT = 0;
   cfg.soft_iron_sigma = 0;
   cfg.disturbance_uT = 0;
-  auto sim = posefuse::simulate_corridor(cfg, 1);
+  auto sim = posefuse::sim::simulate_corridor(cfg, 1);
   const std::int64_t half = (sim.log.imu.front().t_ns + sim.log.imu.back().t_ns) / 2;
   std::erase_if(sim.log.imu, [half](const posefuse::ImuSample& r) { return r.t_ns > half; });
   const auto r = posefuse::run_corridor(sim.log);
@@ -335,10 +335,10 @@ TEST_CASE("Corridor: the compass is aligned to the encoder heading, even when th
           "[fusion][corridor]") {
   // The IMU starts in the middle of the first turn: the robot is at about
   // 45 deg and turning, so "world heading 0 at the IMU's start" would be wrong.
-  auto sim = posefuse::simulate_corridor({}, 1);
+  auto sim = posefuse::sim::simulate_corridor({}, 1);
   const auto& turn = sim.manoeuvres.at(1);
   REQUIRE(turn.turn);
-  const std::int64_t t_mid = posefuse::CorridorSimConfig{}.t0_ns +
+  const std::int64_t t_mid = posefuse::sim::CorridorSimConfig{}.t0_ns +
                              std::int64_t(0.5 * (turn.t_start_s + turn.t_end_s) * 1e9);
   std::erase_if(sim.log.imu, [t_mid](const posefuse::ImuSample& r) { return r.t_ns < t_mid; });
   const auto r = posefuse::run_corridor(sim.log);
@@ -359,7 +359,7 @@ TEST_CASE("Corridor: the compass is aligned to the encoder heading, even when th
 TEST_CASE("Corridor: max_yaw_error_deg is the largest after-turn error, with or without ground truth",
           "[fusion][corridor]") {
   for (const bool gt : {true, false}) {
-    auto sim = posefuse::simulate_corridor({}, 1);
+    auto sim = posefuse::sim::simulate_corridor({}, 1);
     if (!gt) sim.log.groundtruth.clear();
     const auto r = posefuse::run_corridor(sim.log);
     for (std::size_t k = 0; k < 4; ++k) {
@@ -377,7 +377,7 @@ TEST_CASE("Corridor: max_yaw_error_deg is the largest after-turn error, with or 
 
 TEST_CASE("Corridor: ground truth not starting at the odometry origin is warned about",
           "[fusion][corridor]") {
-  auto sim = posefuse::simulate_corridor({}, 1);
+  auto sim = posefuse::sim::simulate_corridor({}, 1);
   for (auto& g : sim.log.groundtruth) g.pose(2) = posefuse::wrap_angle(g.pose(2) + 0.5);
   const auto r = posefuse::run_corridor(sim.log);
   CHECK(has_warning(r, "assume ground truth in the odometry frame"));
@@ -394,16 +394,16 @@ TEST_CASE("Corridor: the log clock is exact and cannot overflow", "[fusion][corr
   CHECK(posefuse::corridor::LogClock{lo}(hi) == Approx(1.8446744073709552e10).epsilon(1e-15));
   CHECK(posefuse::corridor::LogClock{hi}(lo) == Approx(-1.8446744073709552e10).epsilon(1e-15));
   // A simulated log at the very start of the int64 clock runs like any other.
-  posefuse::CorridorSimConfig cfg;
+  posefuse::sim::CorridorSimConfig cfg;
   cfg.t0_ns = lo;
-  const auto sim = posefuse::simulate_corridor(cfg, 1);
+  const auto sim = posefuse::sim::simulate_corridor(cfg, 1);
   const auto span = posefuse::corridor::log_span(sim.log);
   CHECK(span.clock.t0_ns >= lo);
   CHECK(span.duration_s == Approx(sim.duration_s).margin(0.01));
   const auto r = posefuse::run_corridor(sim.log);
   CHECK(r.duration_s == span.duration_s);
   // Only the clock's origin differs from the default run: every figure is the same.
-  const auto ref = posefuse::run_corridor(posefuse::simulate_corridor({}, 1).log);
+  const auto ref = posefuse::run_corridor(posefuse::sim::simulate_corridor({}, 1).log);
   for (std::size_t k = 0; k < 4; ++k) {
     CHECK(r.metrics[k].loop_closure_error_m == ref.metrics[k].loop_closure_error_m);
     CHECK(r.metrics[k].rmse_m == ref.metrics[k].rmse_m);
@@ -412,7 +412,7 @@ TEST_CASE("Corridor: the log clock is exact and cannot overflow", "[fusion][corr
 }
 
 TEST_CASE("Corridor: the steps of the runner on their own", "[fusion][corridor]") {
-  const auto sim = posefuse::simulate_corridor({}, 1);
+  const auto sim = posefuse::sim::simulate_corridor({}, 1);
   const auto& log = sim.log;
   // Magnetometer: the horizontal fit over the whole log, or none.
   const auto fitted = posefuse::corridor::calibrate_magnetometer(log, true);
@@ -455,7 +455,7 @@ TEST_CASE("Corridor: the steps of the runner on their own", "[fusion][corridor]"
 
 TEST_CASE("Corridor: an in-memory log with SLAM rows out of time order is an error",
           "[fusion][corridor]") {
-  auto sim = posefuse::simulate_corridor({}, 1);
+  auto sim = posefuse::sim::simulate_corridor({}, 1);
   std::swap(sim.log.slam[100], sim.log.slam[101]);
   CHECK_THROWS_AS(posefuse::run_corridor(sim.log), posefuse::invalid_argument);
   CHECK_THROWS_WITH(posefuse::run_corridor(sim.log), Catch::Contains("stream 2 is not in time order"));

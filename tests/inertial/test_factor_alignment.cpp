@@ -6,7 +6,7 @@
 #include <cmath>
 #include <random>
 
-#include <apps/sim/imu.hpp>
+#include <posefuse/sim/imu.hpp>
 #include <posefuse/inertial/imu_factor.hpp>
 #include <posefuse/testing/conformance.hpp>
 

@@ -9,8 +9,8 @@
 #include <limits>
 #include <vector>
 
-#include <apps/dense_preintegration.hpp>
-#include <apps/sim/imu.hpp>
+#include <posefuse/testing/dense_preintegration.hpp>
+#include <posefuse/sim/imu.hpp>
 #include <posefuse/inertial/preintegration.hpp>
 #include <posefuse/testing/conformance.hpp>
 
@@ -56,7 +56,7 @@ double normalised_difference(const Eigen::Matrix<double, 15, 15>& P,
 // The structured pre-integration equals the dense reference: covariance to
 // 1e-12 of each entry's scale (and exactly symmetric), bias Jacobians to
 // 1e-12 of their largest entry, the deltas within `delta_tol`.
-void check_equals_dense(const Preintegration& pre, const posefuse::apps::DensePreintegration& dense,
+void check_equals_dense(const Preintegration& pre, const posefuse::testing::DensePreintegration& dense,
                         double delta_tol) {
   const Eigen::Matrix<double, 15, 15> P = pre.covariance();
   const double worst = normalised_difference(P, dense.covariance());
@@ -181,7 +181,7 @@ TEST_CASE("Preintegration: the structured update equals the dense F P F^T + G Q 
   lin.accel << 0.05, 0.0, 0.1;
   lin.gyro << 0.005, 0.01, 0.0;
   Preintegration pre(ImuNoise{}, lin);
-  posefuse::apps::DensePreintegration dense(ImuNoise{}, lin);
+  posefuse::testing::DensePreintegration dense(ImuNoise{}, lin);
   for (const ImuSample& s : seq.samples) {
     (void)pre.add(s);
     dense.add(s);
@@ -205,7 +205,7 @@ TEST_CASE("Preintegration: structured equals dense over a long window with large
   c.initial_bias.gyro << 0.01, -0.02, 0.03;
   const posefuse::sim::ImuSequence seq = posefuse::sim::simulate_imu(c, 60.0);
   Preintegration pre(ImuNoise{}, ImuBias{}, posefuse::PreintegrationOptions{.reserve_samples = 4096});
-  posefuse::apps::DensePreintegration dense(ImuNoise{}, ImuBias{});
+  posefuse::testing::DensePreintegration dense(ImuNoise{}, ImuBias{});
   double max_step = 0, min_step = 1e9;
   for (std::size_t k = 0; k < seq.samples.size(); ++k) {
     if (k > 0) {

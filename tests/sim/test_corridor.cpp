@@ -7,15 +7,15 @@
 #include <limits>
 #include <numbers>
 #include <set>
-#include <apps/sim/corridor.hpp>
+#include <posefuse/sim/corridor.hpp>
 #include <posefuse/core/time.hpp>
 
-using posefuse::CorridorSimConfig;
+using posefuse::sim::CorridorSimConfig;
 using posefuse::SlamState;
-using posefuse::simulate_corridor;
+using posefuse::sim::simulate_corridor;
 
 namespace {
-const posefuse::CorridorSimulation& sim1() {
+const posefuse::sim::CorridorSimulation& sim1() {
   static const auto s = simulate_corridor({}, 1);
   return s;
 }

@@ -16,7 +16,7 @@
 #include <vector>
 #include <unistd.h>
 #include <posefuse/io/robot_log.hpp>
-#include <apps/sim/corridor.hpp>
+#include <posefuse/sim/corridor.hpp>
 
 namespace fs = std::filesystem;
 
@@ -97,7 +97,7 @@ TEST_CASE("RobotLog: a minimal log reads back with every field", "[sim][io][robo
 
 TEST_CASE("RobotLog: the simulator's log round-trips bit-identically", "[sim][io][robot_log]") {
   Scratch d;
-  const auto sim = posefuse::simulate_corridor({}, 3);
+  const auto sim = posefuse::sim::simulate_corridor({}, 3);
   posefuse::write_robot_log(d.path(), sim.log);
   for (const char* f : {"robot.txt", "wheels.csv", "imu.csv", "slam.csv", "groundtruth.csv"})
     CHECK(fs::is_regular_file(d.path() / f));
@@ -239,7 +239,7 @@ TEST_CASE("RobotLog: logs that parse but cannot be right are rejected, naming th
 }
 
 TEST_CASE("RobotLog: doubtful encoders and ground truth give warnings", "[sim][io][robot_log]") {
-  const auto sim = posefuse::simulate_corridor({}, 1);
+  const auto sim = posefuse::sim::simulate_corridor({}, 1);
   CHECK(posefuse::check_robot_log(sim.log).empty());
   const auto warned = [](const std::vector<std::string>& w, const char* part) {
     return std::any_of(w.begin(), w.end(),
@@ -332,7 +332,7 @@ TEST_CASE("RobotLog: writing does not depend on the global locale", "[sim][io][r
   // Regression: the int64 columns went through operator<< with the global
   // locale, so a grouping locale wrote "1,700,000,000,..." into the CSV.
   Scratch d;
-  const auto sim = posefuse::simulate_corridor({}, 3);
+  const auto sim = posefuse::sim::simulate_corridor({}, 3);
   const std::locale old =
       std::locale::global(std::locale(std::locale::classic(), new GroupingNumpunct));
   std::ostringstream probe;
@@ -400,7 +400,7 @@ TEST_CASE("RobotLog: a path component longer than the system allows is an io_err
     return false;
   };
   CHECK(named([&] { (void)posefuse::read_robot_log(dir); }));
-  CHECK(named([&] { posefuse::write_robot_log(dir, posefuse::simulate_corridor({}, 1).log); }));
+  CHECK(named([&] { posefuse::write_robot_log(dir, posefuse::sim::simulate_corridor({}, 1).log); }));
   // A too-long name inside an existing folder.
   const fs::path file = d.path() / (std::string(300, 'b') + ".txt");
   CHECK_THROWS_WITH(posefuse::read_robot_params(file),

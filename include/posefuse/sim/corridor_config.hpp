@@ -10,7 +10,7 @@
 
 #include <posefuse/core/error.hpp>
 
-namespace posefuse {
+namespace posefuse::sim {
 
 /// Parameters of simulate_corridor(); defaults are the documented scenario.
 struct CorridorSimConfig {
@@ -114,4 +114,4 @@ inline void validate(const CorridorSimConfig& c) {
   if (!(c.reinit_after_corner3_m < c.leg_a_m)) fail("reinit_after_corner3_m must lie within leg 3");
 }
 
-}  // namespace posefuse
+}  // namespace posefuse::sim

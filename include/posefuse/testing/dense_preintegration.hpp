@@ -13,7 +13,7 @@
 #include <Eigen/Core>
 #include <posefuse/inertial/preintegration.hpp>
 
-namespace posefuse::apps {
+namespace posefuse::testing {
 
 /// Blocks of one mid-point step's transition in the right (body) form of
 /// inertial/preintegration.hpp's file comment.
@@ -133,4 +133,4 @@ class DensePreintegration {
   Eigen::Matrix<double, 18, 18> Q_;
 };
 
-}  // namespace posefuse::apps
+}  // namespace posefuse::testing

@@ -54,9 +54,9 @@
 #include <posefuse/core/error.hpp>
 #include <posefuse/core/samples.hpp>
 #include <posefuse/io/robot_log.hpp>
-#include <apps/sim/corridor_config.hpp>
+#include <posefuse/sim/corridor_config.hpp>
 
-namespace posefuse {
+namespace posefuse::sim {
 
 /// One leg or turn of the drive, for evaluation.
 struct CorridorManoeuvre {
@@ -386,4 +386,4 @@ inline std::array<double, 4> quat_from_zyx(double yaw, double pitch, double roll
   return out;
 }
 
-}  // namespace posefuse
+}  // namespace posefuse::sim
