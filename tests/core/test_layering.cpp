@@ -1,4 +1,4 @@
-// The library's one-way layering (DESIGN.md): a header under
+// The library's one-way layering (docs/design.md): a header under
 // include/posefuse/<folder>/ may include headers of its own folder and of
 // folders of a lower rank, never of a higher rank and never of a sibling of
 // the same rank. This test reads every header and fails on any arrow that
@@ -21,10 +21,14 @@ const std::map<std::string, int>& ranks() {
   static const std::map<std::string, int> r{
       {"core", 0},                                           // Eigen and the standard library only
       {"lie", 1},                                            // SO2 SE2 SO3 SE3
-      {"models", 2}, {"io", 2}, {"eval", 2}, {"testing", 2},  // siblings: none includes another
+      {"models", 2}, {"io", 2}, {"eval", 2},                 // siblings: none includes another
       {"filters", 3},                                        // estimators over models
       {"sensors", 4},                                        // raw samples -> model inputs (may run filters)
-      {"fusion", 5}, {"inertial", 5}, {"graph", 5},           // top layer
+      {"fusion", 5}, {"inertial", 5}, {"graph", 5},           // the estimators' top layer
+      // Beside the recommended API, above all of it: the conformance harness
+      // and test references, the simulators, and the seed documents'
+      // formulas reproduced as printed.
+      {"testing", 6}, {"sim", 6}, {"seed", 6},
   };
   return r;
 }
@@ -90,11 +94,9 @@ TEST_CASE("Layering: no header includes a layer above it or a sibling", "[core][
 }
 
 TEST_CASE("Layering: the seed programs' code is not in the library", "[core][layering]") {
-  // Runners, experiment metrics and simulators live in examples/apps/.
-  for (const char* gone : {"sim", "apps"}) {
-    INFO(gone);
-    CHECK_FALSE(fs::exists(include_root() / gone));
-  }
+  // Runners and experiment metrics live in examples/apps/ (the simulators the
+  // library's own tests use are library code, in include/posefuse/sim/).
+  CHECK_FALSE(fs::exists(include_root() / "apps"));
   for (const char* gone :
        {"fusion/corridor_runner.hpp", "fusion/corridor_metrics.hpp", "filters/trajectory_correction.hpp"}) {
     INFO(gone);
@@ -113,4 +115,34 @@ TEST_CASE("Layering: the seed programs' code is not in the library", "[core][lay
       CHECK_FALSE(std::regex_search(text, apps_re));
     }
   }
+}
+
+TEST_CASE("Layering: headers name only documents that are in the repository", "[core][layering]") {
+  // A comment that sends the reader to a file must send them to one they
+  // have: any `something.md` named in a header must exist, relative to the
+  // repository root, and no header may point outside the repository.
+  const fs::path root(POSEFUSE_SOURCE_DIR);
+  const std::regex doc_re(R"(([A-Za-z0-9_./-]+)\.md\b)");
+  const std::regex outside_re(R"(\.\./shared|\.\./\.\./)");
+  int named = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(include_root())) {
+    if (!entry.is_regular_file()) continue;
+    std::ifstream in(entry.path());
+    std::string text;
+    int line_no = 0;
+    while (std::getline(in, text)) {
+      ++line_no;
+      const std::string where = fs::relative(entry.path(), root).string() + ":" + std::to_string(line_no);
+      INFO(where << ": " << text);
+      CHECK_FALSE(std::regex_search(text, outside_re));
+      for (std::sregex_iterator it(text.begin(), text.end(), doc_re), end; it != end; ++it) {
+        ++named;
+        const std::string doc = (*it)[1].str() + ".md";
+        INFO("names " << doc);
+        CHECK(fs::is_regular_file(root / doc));
+      }
+    }
+  }
+  // The check above must have something to check: the headers do point to docs/.
+  CHECK(named > 0);
 }

@@ -1,8 +1,9 @@
 #pragma once
 /// @file
-/// A seeded simulation of seed 001's corridor experiment (SPEC.md §B, issue 3
-/// item 6), written as a posefuse::RobotLog so that the same fusion code runs
-/// on it and on recorded logs.
+/// A seeded simulation of seed 001's corridor experiment (the indoor robot
+/// whose visual SLAM is lost at a feature-poor corner; docs/reproductions.md),
+/// written as a posefuse::RobotLog so that the same fusion code runs on it and
+/// on recorded logs.
 ///
 /// **Scenario.** A four-wheel skid-steer robot drives a 14 m x 9 m rectangular
 /// corridor counter-clockwise from point 1 (a corner) and comes back to it:

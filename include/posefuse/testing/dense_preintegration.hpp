@@ -8,7 +8,7 @@
 /// Same mathematics as the structured update — the same mid-point step,
 /// the same F blocks (in the right, body form of the rotation error), the same noise model — so the
 /// two agree to rounding (tests/inertial, 1e-12); it exists only as the
-/// benchmark's and the test's reference. Not part of the library.
+/// benchmark's and the tests' reference, not for estimation.
 
 #include <Eigen/Core>
 #include <posefuse/inertial/preintegration.hpp>
