@@ -24,11 +24,12 @@ const std::map<std::string, int>& ranks() {
       {"models", 2}, {"io", 2}, {"eval", 2},                 // siblings: none includes another
       {"filters", 3},                                        // estimators over models
       {"sensors", 4},                                        // raw samples -> model inputs (may run filters)
-      {"fusion", 5}, {"inertial", 5}, {"graph", 5},           // the estimators' top layer
+      {"fusion", 5}, {"inertial", 5}, {"graph", 5},           // estimators over sensors
+      {"vio", 6},                                            // the visual-inertial estimator
       // Beside the recommended API, above all of it: the conformance harness
       // and test references, the simulators, and the seed documents'
       // formulas reproduced as printed.
-      {"testing", 6}, {"sim", 6}, {"seed", 6},
+      {"testing", 7}, {"sim", 7}, {"seed", 7},
   };
   return r;
 }
