@@ -8,7 +8,7 @@
 #include <cmath>
 #include <apps/corridor_runner.hpp>
 #include <posefuse/fusion/gated_fuser.hpp>
-#include <posefuse/fusion/threshold_fuser.hpp>
+#include <posefuse/seed/threshold_fuser.hpp>
 #include <posefuse/sim/corridor.hpp>
 
 namespace {
@@ -28,10 +28,10 @@ std::array<posefuse::PlanarPose<T>, kN> circle_poses(T noise) {
 
 template <class T>
 void BM_ThresholdFuser_Step(benchmark::State& state) {
-  const posefuse::ThresholdFuser<T> fuser(T(0.01));
+  const posefuse::seed::ThresholdFuser<T> fuser(T(0.01));
   const auto odom = circle_poses<T>(T(0));
   const auto slam = circle_poses<T>(T(0.03));
-  std::array<typename posefuse::ThresholdFuser<T>::Input, kN> in{};
+  std::array<typename posefuse::seed::ThresholdFuser<T>::Input, kN> in{};
   for (std::size_t i = 0; i < kN; ++i)
     in[i] = {{odom[i].x, odom[i].y, T(0.01), T(-0.02), odom[i].theta},
              {slam[i].x, slam[i].y, T(0), T(0), slam[i].theta}};

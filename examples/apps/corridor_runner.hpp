@@ -87,10 +87,10 @@
 #include <posefuse/core/time.hpp>
 #include <posefuse/core/trajectory.hpp>
 #include <posefuse/fusion/gated_fuser.hpp>
-#include <posefuse/fusion/threshold_fuser.hpp>
 #include <posefuse/io/robot_log.hpp>
 #include <posefuse/io/robot_log_checks.hpp>
 #include <posefuse/lie/rotation.hpp>
+#include <posefuse/seed/threshold_fuser.hpp>
 #include <posefuse/sensors/magnetometer_calibration.hpp>
 #include <posefuse/sensors/pipelines.hpp>
 
@@ -188,7 +188,7 @@ struct LogSpan {
 /// The planar pose of an (x, y, θ) vector (exact).
 [[nodiscard]] inline PlanarPose<double> pose_of(const Eigen::Vector3d& v) { return {v(0), v(1), v(2)}; }
 /// The planar part (x, y, wrapped yaw) of a seed odometry vector.
-[[nodiscard]] inline PlanarPose<double> planar(const SeedOdometry<double>& o) {
+[[nodiscard]] inline PlanarPose<double> planar(const seed::SeedOdometry<double>& o) {
   return {o.x, o.y, wrap_angle(o.yaw)};
 }
 
@@ -313,13 +313,14 @@ class AttitudeTracker {
 
 /// Odometry at one time: dead reckoning (x, y, θ_enc) and the seed's O_m.
 struct OdometryAt {
-  PlanarPose<double> dr;     ///< encoder dead reckoning
-  SeedOdometry<double> om;   ///< O_m: wheels' x, y; IMU roll, pitch, yaw (or the fallback)
+  PlanarPose<double> dr;          ///< encoder dead reckoning
+  seed::SeedOdometry<double> om;  ///< O_m: wheels' x, y; IMU roll, pitch, yaw (or the fallback)
 };
 
 /// O_m interpolated between two samples: x, y linearly, angles along the shorter arc.
-[[nodiscard]] inline SeedOdometry<double> interpolate(const SeedOdometry<double>& a,
-                                                      const SeedOdometry<double>& b, double f) {
+[[nodiscard]] inline seed::SeedOdometry<double> interpolate(const seed::SeedOdometry<double>& a,
+                                                            const seed::SeedOdometry<double>& b,
+                                                            double f) {
   return {a.x + f * (b.x - a.x), a.y + f * (b.y - a.y), angle_interpolate(a.roll, b.roll, f),
           angle_interpolate(a.pitch, b.pitch, f), angle_interpolate(a.yaw, b.yaw, f)};
 }
@@ -417,7 +418,7 @@ class SeedFuserMethod {
 
   /// Fuses a SLAM pose with O_m at its time; (re)places the map on `reinit`
   /// or after the fuser's own re-initialise signal.
-  void on_slam(const SlamPose& s, const SeedOdometry<double>& om, PlanarTrajectory& track,
+  void on_slam(const SlamPose& s, const seed::SeedOdometry<double>& om, PlanarTrajectory& track,
                CorridorRunResult& res) {
     if (s.reinit || place_) {
       T_world_map_ = se2_compose(planar(om), se2_inverse(s.z));
@@ -426,7 +427,7 @@ class SeedFuserMethod {
       started_ = true;
     }
     const PlanarPose<double> zw = se2_compose(T_world_map_, s.z);
-    const SeedOdometry<double> ov{zw.x, zw.y, s.euler.roll, s.euler.pitch, zw.theta};
+    const seed::SeedOdometry<double> ov{zw.x, zw.y, s.euler.roll, s.euler.pitch, zw.theta};
     const auto out = fuser_({om, ov});
     (out.averaged ? res.seed_averaged : res.seed_fallback) += 1;
     place_ = out.reinitialise;
@@ -434,12 +435,12 @@ class SeedFuserMethod {
     last_slam_t_ = s.t;
   }
   /// At a wheel sample: O_r = O_m when SLAM is lost or stale (eq 15-b).
-  void on_wheel(double t, const SeedOdometry<double>& om, PlanarTrajectory& track) const {
+  void on_wheel(double t, const seed::SeedOdometry<double>& om, PlanarTrajectory& track) const {
     if (t - last_slam_t_ > stale_s_) track.push_back(t, xyt(planar(om)));
   }
 
  private:
-  ThresholdFuser<double> fuser_;
+  seed::ThresholdFuser<double> fuser_;
   double stale_s_;
   double last_slam_t_ = -1e300;
   bool place_ = true, started_ = false;

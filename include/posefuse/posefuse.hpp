@@ -28,7 +28,7 @@
 #include <posefuse/fusion/fuse_poses.hpp>
 #include <posefuse/fusion/fuser_status.hpp>
 #include <posefuse/fusion/gated_fuser.hpp>
-#include <posefuse/fusion/threshold_fuser.hpp>
+#include <posefuse/seed/threshold_fuser.hpp>
 #include <posefuse/io/association.hpp>
 #include <posefuse/io/formats.hpp>
 #include <posefuse/io/robot_log.hpp>

@@ -6,10 +6,10 @@
 #include <numbers>
 #include <posefuse/core/pipeline.hpp>
 #include <posefuse/fusion/gated_fuser.hpp>
-#include <posefuse/fusion/threshold_fuser.hpp>
+#include <posefuse/seed/threshold_fuser.hpp>
 
-using posefuse::SeedOdometry;
-using posefuse::ThresholdFuser;
+using posefuse::seed::SeedOdometry;
+using posefuse::seed::ThresholdFuser;
 
 static_assert(posefuse::Stage<ThresholdFuser<double>>);
 static_assert(posefuse::Stage<ThresholdFuser<float>>);
@@ -21,8 +21,8 @@ TEMPLATE_TEST_CASE("ThresholdFuser: eq 14 against a hand-worked value", "[fusion
   const SeedOdometry<T> v{};
   // sqrt((1 + 4) / 2) = 1.58113883; sqrt((0.01 + 0.04 + 0.09) / 3) = 0.21602469;
   // product / 3 = 0.11385501.
-  CHECK(posefuse::seed_o_diff(m, v) == Approx(0.11385501).epsilon(1e-5));
-  CHECK(posefuse::seed_o_diff(v, m) == Approx(0.11385501).epsilon(1e-5));
+  CHECK(posefuse::seed::seed_o_diff(m, v) == Approx(0.11385501).epsilon(1e-5));
+  CHECK(posefuse::seed::seed_o_diff(v, m) == Approx(0.11385501).epsilon(1e-5));
 }
 
 TEMPLATE_TEST_CASE("ThresholdFuser: eq 15 averages below the threshold, falls back above it",
@@ -76,11 +76,11 @@ TEST_CASE("ThresholdFuser: flaw 2 — plain angle arithmetic breaks across ±180
   const SeedOdometry<double> m{0, 0, 0, 0, d179};
   const SeedOdometry<double> v{0, 0, 0, 0, -d179};
   // eq 15-a: (179° + -179°) / 2 = 0°, the opposite direction.
-  CHECK(posefuse::seed_average(m, v).yaw == Approx(0.0).margin(1e-12));
+  CHECK(posefuse::seed::seed_average(m, v).yaw == Approx(0.0).margin(1e-12));
   // eq 14 sees a 358° disagreement where there is 2°.
   const SeedOdometry<double> m2{1, 0, 0, 0, d179};
   const SeedOdometry<double> v2{0, 0, 0, 0, -d179};
-  const double seen = posefuse::seed_o_diff(m2, v2);
+  const double seen = posefuse::seed::seed_o_diff(m2, v2);
   const double true_diff = std::sqrt(0.5) * std::sqrt((2.0 * std::numbers::pi / 180.0) *
                                                       (2.0 * std::numbers::pi / 180.0) / 3.0) / 3.0;
   CHECK(seen == Approx(true_diff * 179.0));

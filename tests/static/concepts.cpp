@@ -11,12 +11,12 @@
 #include <posefuse/models/position.hpp>
 #include <posefuse/models/se2_odometry.hpp>
 #include <posefuse/fusion/gated_fuser.hpp>
-#include <posefuse/fusion/threshold_fuser.hpp>
 #include <posefuse/lie/se2.hpp>
 #include <posefuse/lie/se3.hpp>
 #include <posefuse/lie/so2.hpp>
 #include <posefuse/lie/so3.hpp>
 #include <posefuse/models/unicycle.hpp>
+#include <posefuse/seed/threshold_fuser.hpp>
 #include <posefuse/sensors/pipelines.hpp>
 
 namespace {
@@ -129,9 +129,9 @@ static_assert(std::is_same_v<Seed000::Covariance, Eigen::Matrix2d>);
 // posefuse/fusion/gated_fuser.hpp
 static_assert(Stage<GatedFuser<double>>);
 static_assert(Stage<GatedFuser<float>>);
-// posefuse/fusion/threshold_fuser.hpp
-static_assert(Stage<ThresholdFuser<double>>);
-static_assert(Stage<ThresholdFuser<float>>);
+// posefuse/seed/threshold_fuser.hpp
+static_assert(Stage<seed::ThresholdFuser<double>>);
+static_assert(Stage<seed::ThresholdFuser<float>>);
 // posefuse/lie/se2.hpp
 static_assert(Manifold<SE2<double>>);
 static_assert(Manifold<SE2<float>>);

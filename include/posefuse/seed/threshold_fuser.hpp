@@ -1,8 +1,7 @@
 #pragma once
 /// @file
 /// Seed 001's threshold fuser, eq 14-15, reproduced exactly as printed —
-/// including its two flaws, which the tests demonstrate and
-/// posefuse::GatedFuser (gated_fuser.hpp) fixes:
+/// including its two flaws, which the tests demonstrate:
 ///
 /// 1. **Multiplied RMS terms.** \f$O_{diff}\f$ is the *product* of the
 ///    position RMS and the angle RMS, so a large position disagreement passes
@@ -15,6 +14,11 @@
 /// Units: positions in metres, angles in radians, so the threshold is in
 /// m·rad. The fuser is stateless: eq 15 never feeds \f$O_r\f$ back into the
 /// robot odometry \f$O_m\f$, so \f$O_m\f$ keeps its own drift.
+///
+/// A reproduction, in posefuse::seed apart from the recommended API: do not
+/// use it to navigate. The sound fuser is posefuse::GatedFuser
+/// (fusion/gated_fuser.hpp): covariance-weighted, with separate position and
+/// heading gates and angles averaged on the circle.
 
 #include <cmath>
 #include <concepts>
@@ -22,7 +26,7 @@
 #include <posefuse/core/error.hpp>
 #include <posefuse/core/pipeline.hpp>
 
-namespace posefuse {
+namespace posefuse::seed {
 
 /// Seed 001's odometry vector \f$O = [x, y, \rho, \phi, \theta]\f$: position
 /// (m) in the odometry/world frame and roll, pitch, yaw (rad, ZYX). z is
@@ -113,4 +117,4 @@ class ThresholdFuser {
   T threshold_;
 };
 
-}  // namespace posefuse
+}  // namespace posefuse::seed
