@@ -1,10 +1,12 @@
-// Tests for sensors/accelerometer_tilt.hpp (seed 001 eq 1-2 and the REP-103 form).
+// Tests for sensors/accelerometer_tilt.hpp (seed 001 eq 1-2 in the REP-103 form) and
+// seed/accelerometer_tilt.hpp (eq 1-2 as printed).
 #include <catch2/catch.hpp>
 
 #include <cmath>
 #include <numbers>
 #include <posefuse/core/angles.hpp>
 #include <posefuse/lie/rotation.hpp>
+#include <posefuse/seed/accelerometer_tilt.hpp>
 #include <posefuse/sensors/accelerometer_tilt.hpp>
 #include <random>
 
@@ -26,11 +28,11 @@ TEMPLATE_TEST_CASE("AccelerometerTilt: eq 1-2 as printed, hand-worked", "[sensor
   using T = TestType;
   // a = (1, 2, 2): rho_a = atan(1 / sqrt(4 + 4)) = atan(0.353553) = 0.339837 rad (eq 1),
   //                phi_a = atan(2 / sqrt(1 + 4)) = atan(0.894427) = 0.729728 rad (eq 2).
-  const posefuse::Tilt<T> t = posefuse::accelerometer_tilt(Eigen::Matrix<T, 3, 1>(1, 2, 2));
+  const posefuse::Tilt<T> t = posefuse::seed::accelerometer_tilt(Eigen::Matrix<T, 3, 1>(1, 2, 2));
   CHECK(t.roll == Approx(0.3398369094541219).epsilon(tol<T>()));
   CHECK(t.pitch == Approx(0.7297276562269663).epsilon(tol<T>()));
   // atan keeps both in [-90, 90] deg even with the sensor upside down (az < 0).
-  const posefuse::Tilt<T> u = posefuse::accelerometer_tilt(Eigen::Matrix<T, 3, 1>(1, 2, -2));
+  const posefuse::Tilt<T> u = posefuse::seed::accelerometer_tilt(Eigen::Matrix<T, 3, 1>(1, 2, -2));
   CHECK(u.roll == Approx(t.roll).epsilon(tol<T>()));
   CHECK(u.pitch == Approx(t.pitch).epsilon(tol<T>()));
 }
@@ -75,7 +77,7 @@ TEMPLATE_TEST_CASE("AccelerometerTilt: the seed's angles in REP-103 axes", "[sen
   std::uniform_real_distribution<double> ang(-1.2, 1.2);
   for (int i = 0; i < 200; ++i) {
     const T r = T(ang(rng)), p = T(ang(rng));
-    const posefuse::Tilt<T> s = posefuse::accelerometer_tilt(at_rest(r, p, T(0.3)));
+    const posefuse::Tilt<T> s = posefuse::seed::accelerometer_tilt(at_rest(r, p, T(0.3)));
     const T m = std::is_same_v<T, float> ? T(1e-5) : T(1e-12);
     REQUIRE(s.roll == Approx(-p).margin(m));
     REQUIRE(s.pitch == Approx(std::asin(std::cos(p) * std::sin(r))).margin(m));

@@ -1,26 +1,23 @@
 #pragma once
 /// @file
 /// Roll and pitch from the accelerometer's measurement of gravity (seed 001
-/// eq 1-2), and the first stage of the attitude chain (its input is the
-/// library's raw ImuSample, core/samples.hpp).
+/// eq 1-2, in the REP-103 body frame), and the first stage of the attitude
+/// chain (its input is the library's raw ImuSample, core/samples.hpp).
 ///
-/// Two conventions are offered:
-///  * accelerometer_tilt() is eq 1-2 exactly as printed, in the seed's own IMU
-///    axes (its Fig. 1, an EBIMU-9DOFV3): \f$ \rho_a \f$ ("roll") is the
-///    elevation of the sensor's x axis above the horizontal plane and
-///    \f$ \phi_a \f$ ("pitch") that of its y axis. `atan` (not `atan2`) keeps
-///    both in [-90°, 90°].
-///  * accelerometer_tilt_rep103() is the REP-103 body frame (x forward, y
-///    left, z up) with the accelerometer reading specific force, i.e.
-///    \f$ a = R^\top (0, 0, +g) \f$ at rest (+9.81 m/s² on z when level).
-///    For \f$ R = R_z R_y(\mathrm{pitch}) R_x(\mathrm{roll}) \f$ this gives
-///    \f$ a = g(-\sin p, \cos p \sin r, \cos p \cos r) \f$, hence
-///    roll = atan2(ay, az), pitch = atan2(-ax, sqrt(ay² + az²)).
-///    Roll covers (-180°, 180°], pitch [-90°, 90°].
+/// accelerometer_tilt_rep103() uses the REP-103 body frame (x forward, y
+/// left, z up) with the accelerometer reading specific force, i.e.
+/// \f$ a = R^\top (0, 0, +g) \f$ at rest (+9.81 m/s² on z when level).
+/// For \f$ R = R_z R_y(\mathrm{pitch}) R_x(\mathrm{roll}) \f$ this gives
+/// \f$ a = g(-\sin p, \cos p \sin r, \cos p \cos r) \f$, hence
+/// roll = atan2(ay, az), pitch = atan2(-ax, sqrt(ay² + az²)).
+/// Roll covers (-180°, 180°], pitch [-90°, 90°]. The attitude chain
+/// (sensors/pipelines.hpp) uses it.
 ///
-/// In REP-103 axes the seed's angles are \f$ \rho_a = -\mathrm{pitch} \f$ and
-/// \f$ \phi_a = \arcsin(\cos p \sin r) \f$ (= roll only when pitch = 0); the
-/// attitude chain (sensors/pipelines.hpp) therefore uses the REP-103 form.
+/// Seed 001 eq 1-2 exactly as printed, in the seed's own IMU axes, are
+/// posefuse::seed::accelerometer_tilt() (seed/accelerometer_tilt.hpp), a
+/// reproduction: its angles are the elevations of the sensor's x and y axes,
+/// which in REP-103 axes are \f$ -\mathrm{pitch} \f$ and
+/// \f$ \arcsin(\cos p \sin r) \f$ (= roll only when pitch = 0).
 
 #include <Eigen/Core>
 #include <cmath>
@@ -31,25 +28,14 @@
 namespace posefuse {
 
 /// Roll and pitch (rad). For the REP-103 functions these are the ZYX Euler
-/// roll (about body x) and pitch (about body y) of lie/rotation.hpp; for the
-/// seed's eq 1-2 they are \f$ \rho_a \f$ and \f$ \phi_a \f$.
+/// roll (about body x) and pitch (about body y) of lie/rotation.hpp; for
+/// seed::accelerometer_tilt() they are the seed's \f$ \rho_a \f$ and
+/// \f$ \phi_a \f$.
 template <std::floating_point T = double>
 struct Tilt {
   T roll{0};   ///< rad
   T pitch{0};  ///< rad
 };
-
-/// Seed 001 eq 1-2, as printed, in the seed's IMU axes:
-/// \f$ \rho_a = \arctan(A_x / \sqrt{A_y^2 + A_z^2}) \f$,
-/// \f$ \phi_a = \arctan(A_y / \sqrt{A_x^2 + A_z^2}) \f$.
-/// @param[in] a accelerometer reading (any unit; only its direction matters)
-/// @return {roll = rho_a, pitch = phi_a} in rad, each in [-pi/2, pi/2]; NaN
-///         components when a is zero or not finite
-template <std::floating_point T>
-[[nodiscard]] inline Tilt<T> accelerometer_tilt(const Eigen::Matrix<T, 3, 1>& a) noexcept {
-  return {std::atan(a.x() / std::sqrt(a.y() * a.y() + a.z() * a.z())),   // eq 1
-          std::atan(a.y() / std::sqrt(a.x() * a.x() + a.z() * a.z()))};  // eq 2
-}
 
 /// Roll and pitch from gravity in a REP-103 body frame (x forward, y left, z up),
 /// the accelerometer reading specific force (+g on z when level and at rest):
