@@ -1,5 +1,6 @@
-// Tests for sensors/compass.hpp and sensors/magnetometer_calibration.hpp
-// (seed 001 eq 5-7 and hard/soft-iron calibration).
+// Tests for sensors/compass.hpp, sensors/magnetometer_calibration.hpp and
+// seed/tilt_compensated_heading.hpp (seed 001 eq 5-7 corrected and as printed, and
+// hard/soft-iron calibration).
 #include <catch2/catch.hpp>
 
 #include <Eigen/Geometry>
@@ -11,6 +12,7 @@
 #include <posefuse/core/error.hpp>
 #include <posefuse/core/samples.hpp>
 #include <posefuse/lie/rotation.hpp>
+#include <posefuse/seed/tilt_compensated_heading.hpp>
 #include <posefuse/sensors/compass.hpp>
 #include <posefuse/sensors/magnetometer_calibration.hpp>
 #include <random>
@@ -87,8 +89,9 @@ TEMPLATE_TEST_CASE("Compass: heading hand-worked at zero tilt", "[sensors][compa
         Approx(-std::numbers::pi / 2).epsilon(1e-6));
   // The printed eq 5-7 at zero tilt: theta = atan(My / Mx) = atan(-20 / 20) = -pi/4 for a
   // robot at yaw +pi/4, i.e. the printed form measures clockwise.
-  CHECK(posefuse::tilt_compensated_heading_seed(reading(T(0), T(0), T(std::numbers::pi / 4)), T(0),
-                                                T(0)) == Approx(-std::numbers::pi / 4).epsilon(1e-5));
+  CHECK(posefuse::seed::tilt_compensated_heading_seed(reading(T(0), T(0), T(std::numbers::pi / 4)),
+                                                      T(0), T(0)) ==
+        Approx(-std::numbers::pi / 4).epsilon(1e-5));
 }
 
 TEMPLATE_TEST_CASE("Compass: corrected yaw is invariant to roll and pitch (property)",
@@ -104,15 +107,17 @@ TEMPLATE_TEST_CASE("Compass: corrected yaw is invariant to roll and pitch (prope
   }
 }
 
-TEST_CASE("Compass: the printed eq 5-7 are not invariant to tilt (SPEC B check)",
+TEST_CASE("Compass: the printed eq 5-7 are not invariant to tilt",
           "[sensors][compass]") {
-  // SPEC B: with roll 0.2 rad a true yaw of 0.70 rad reads 0.98 rad. Here: REP-103 axes, field
+  // With roll 0.2 rad a true yaw of 0.70 rad reads 0.98 rad. Here: REP-103 axes, field
   // 50 uT with 53 deg dip, robot at yaw 0.70 rolled 0.2 rad; the printed form measures clockwise
   // (-0.70 at zero tilt) and reads -0.981 once rolled.
   const Eigen::Vector3d level = reading(0.0, 0.0, 0.70);
   const Eigen::Vector3d rolled = reading(0.2, 0.0, 0.70);
-  CHECK(posefuse::tilt_compensated_heading_seed(level, 0.0, 0.0) == Approx(-0.70).epsilon(1e-12));
-  CHECK(posefuse::tilt_compensated_heading_seed(rolled, 0.2, 0.0) == Approx(-0.981).margin(5e-4));
+  CHECK(posefuse::seed::tilt_compensated_heading_seed(level, 0.0, 0.0) ==
+        Approx(-0.70).epsilon(1e-12));
+  CHECK(posefuse::seed::tilt_compensated_heading_seed(rolled, 0.2, 0.0) ==
+        Approx(-0.981).margin(5e-4));
   CHECK(posefuse::tilt_compensated_heading(rolled, 0.2, 0.0) == Approx(0.70).epsilon(1e-12));
 
   // The same invariance property fails for the printed form: its reading with tilt differs from
@@ -124,8 +129,10 @@ TEST_CASE("Compass: the printed eq 5-7 are not invariant to tilt (SPEC B check)"
   const int n = 500;
   for (int i = 0; i < n; ++i) {
     const double y = yaw(rng), r = tilt(rng), p = tilt(rng);
-    const double seed_tilted = posefuse::tilt_compensated_heading_seed(reading(r, p, y), r, p);
-    const double seed_level = posefuse::tilt_compensated_heading_seed(reading(0.0, 0.0, y), 0.0, 0.0);
+    const double seed_tilted =
+        posefuse::seed::tilt_compensated_heading_seed(reading(r, p, y), r, p);
+    const double seed_level =
+        posefuse::seed::tilt_compensated_heading_seed(reading(0.0, 0.0, y), 0.0, 0.0);
     const double err = std::abs(posefuse::angle_diff(seed_tilted, seed_level));
     worst = std::max(worst, err);
     if (err > 0.05) ++violations;

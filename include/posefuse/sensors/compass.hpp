@@ -1,7 +1,10 @@
 #pragma once
 /// @file
-/// Tilt-compensated magnetic heading (seed 001 eq 5-7), correct and as printed,
-/// and the compass stage that ends the attitude chain.
+/// Tilt-compensated magnetic heading (seed 001 eq 5-7, corrected) and the
+/// compass stage that ends the attitude chain. Eq 5-7 exactly as printed are
+/// posefuse::seed::tilt_compensated_heading_seed()
+/// (seed/tilt_compensated_heading.hpp), a reproduction that is not invariant
+/// to tilt: do not use it for navigation.
 ///
 /// Frames and sign convention (REP-103): body frame x forward, y left, z up;
 /// world frame x toward magnetic north, y west, z up. Yaw is the ZYX Euler yaw
@@ -47,28 +50,6 @@ template <std::floating_point T>
   const T xh = mag.x() * cp + mag.y() * sp * sr + mag.z() * sp * cr;
   const T yh = mag.y() * cr - mag.z() * sr;
   return wrap_angle(std::atan2(-yh, xh));
-}
-
-/// Seed 001 eq 5-7 exactly as printed (kept to reproduce and test the flaw):
-/// \f$ X'_m = M_x\cos\phi + M_y\sin\rho - M_z\cos\rho\sin\phi \f$ (eq 5),
-/// \f$ Y'_m = M_y\cos\rho + M_z\sin\phi \f$ (eq 6),
-/// \f$ \theta = \arctan(Y'_m / X'_m) \f$ (eq 7).
-/// Known flaws (SPEC B "Checked"): not invariant to tilt (REP-103 axes, dip
-/// 53°, roll 0.2 rad: a yaw of 0.70 rad reads 0.98 rad); `atan` folds the
-/// heading into [-90°, 90°]; and at zero tilt it returns \f$ \arctan(M_y/M_x) \f$,
-/// i.e. the clockwise heading \f$ -\psi \f$ for REP-103 axes. Do not use for
-/// navigation; use tilt_compensated_heading().
-/// @param[in] mag magnetometer components (M_x, M_y, M_z)
-/// @param[in] rho the seed's roll \f$ \rho \f$, rad
-/// @param[in] phi the seed's pitch \f$ \phi \f$, rad
-/// @return \f$ \theta \f$ of eq 7, rad, in [-pi/2, pi/2]
-template <std::floating_point T>
-[[nodiscard]] inline T tilt_compensated_heading_seed(const Eigen::Matrix<T, 3, 1>& mag, T rho,
-                                                     T phi) noexcept {
-  const T xm = mag.x() * std::cos(phi) + mag.y() * std::sin(rho) -
-               mag.z() * std::cos(rho) * std::sin(phi);    // eq 5
-  const T ym = mag.y() * std::cos(rho) + mag.z() * std::sin(phi);  // eq 6
-  return std::atan(ym / xm);                                        // eq 7
 }
 
 /// Roll, pitch and yaw of the body at one time (rad, REP-103 ZYX; yaw from
