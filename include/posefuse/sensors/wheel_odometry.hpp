@@ -7,7 +7,9 @@
 /// \f$ 2\pi \Delta E / N \f$ rad and moves its contact point by
 /// \f$ m_{tick} \Delta E \f$ metres with \f$ m_{tick} = 2\pi r / N \f$.
 /// Eq 9 prints \f$ v = r(\Delta E_R + \Delta E_L)/2 \f$ and calls r the wheel
-/// *diameter*; with increments in radians r must be the **radius** (SPEC B).
+/// *diameter*; with increments in radians r must be the **radius** (a wheel
+/// turning by an angle a moves its contact point by r a). Only the radius
+/// form is implemented.
 /// Body frame REP-103 (x forward, y left); a positive turn is counter-clockwise.
 ///
 /// The chain's input is the library's raw WheelSample (core/samples.hpp):
