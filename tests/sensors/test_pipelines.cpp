@@ -91,6 +91,29 @@ TEST_CASE("Pipelines: Euler-kinematics gyro mapping tracks tilt while turning, e
   CHECK(std::abs(a.roll - 0.2) < 0.03);
 }
 
+TEST_CASE("Pipelines: the defaults are the sound variants; the seed's printed forms are options",
+          "[sensors][pipelines]") {
+  CHECK(AttitudeConfig{}.gyro_mapping == GyroToTiltRate::kEulerKinematics);
+  CHECK(DeadReckoning{}.method() == Integration::kExactArc);
+  CHECK(make_odometry_pipeline(DiffDriveParams{1000.0, 0.05, 0.40}).stage<2>().method() ==
+        Integration::kExactArc);
+  // A stage built without a mapping follows the Euler kinematics, not eq 3-4 as printed:
+  // tilted and turning, the two mappings differ.
+  AccelerometerTiltStage tilt;
+  ComplementaryTiltStage plain(0.98), kin(0.98, GyroToTiltRate::kEulerKinematics),
+      seed(0.98, GyroToTiltRate::kSeed);
+  TiltedImu a, b, c;
+  for (int k = 0; k <= 200; ++k) {
+    const TiltedImu in = tilt(imu_at(0.01 * k, 0.2, 0.1, wrap_angle(0.5 * 0.01 * k), 0.5));
+    a = plain(in);
+    b = kin(in);
+    c = seed(in);
+  }
+  CHECK(a.tilt.roll == b.tilt.roll);
+  CHECK(a.tilt.pitch == b.tilt.pitch);
+  CHECK(std::abs(a.tilt.roll - c.tilt.roll) > 0.01);
+}
+
 TEST_CASE("Pipelines: odometry chain drives the closed-form circle", "[sensors][pipelines]") {
   const DiffDriveParams p{1000.0, 0.05, 0.40};
   OdometryPipeline odo = make_odometry_pipeline(p, WheelNoiseParams{0.3, 0.01});

@@ -7,6 +7,15 @@
 /// The step \f$ \Delta t = t_i - t_{i-1} \f$ comes from the sample time stamps.
 /// The filter is generic over N independent angle channels (N = 2: roll and
 /// pitch as in the seed).
+///
+/// The blend is the sound form: it equals eq 3-4 as printed while the
+/// prediction and the absolute angle are less than 180° apart, and blends
+/// along the short arc across ±180°, where the printed arithmetic goes the
+/// long way round (α = 0.98, prediction 179°, absolute angle -179°: 179.04°
+/// here, 171.84° as printed). There is no option for the printed form.
+/// Which rates drive each channel is the caller's choice; the attitude chain
+/// (sensors/pipelines.hpp) offers the seed's gyro_x, gyro_y as printed
+/// (GyroToTiltRate::kSeed) and, by default, the Euler kinematics.
 
 #include <Eigen/Core>
 #include <cmath>

@@ -13,6 +13,9 @@
 ///    \f$ x' = x + \Delta s\,\mathrm{sinc}(\Delta\theta/2)\cos(\theta + \Delta\theta/2) \f$,
 ///    \f$ y' = y + \Delta s\,\mathrm{sinc}(\Delta\theta/2)\sin(\theta + \Delta\theta/2) \f$,
 ///    \f$ \theta' = \theta + \Delta\theta \f$.
+/// kExactArc is the default wherever a default exists (Unicycle::method,
+/// and in sensors/ DeadReckoning and make_odometry_pipeline); kEuler
+/// reproduces the seed and is selected explicitly.
 /// World frame x, y (m), heading counter-clockwise from x (rad), REP-103.
 
 #include <Eigen/Core>
@@ -30,7 +33,7 @@ namespace posefuse {
 /// How a unicycle step is integrated.
 enum class Integration : std::uint8_t {
   kEuler,     ///< seed 001 eq 10 as printed (first order; drifts on curves)
-  kExactArc,  ///< exact for constant v and w over the step
+  kExactArc,  ///< exact for constant v and w over the step; the default
 };
 
 namespace detail {
@@ -108,7 +111,7 @@ struct Unicycle {
   using State = PlanarPose<T>;
   using Control = Eigen::Matrix<T, 2, 1>;  ///< (v m/s, w rad/s)
 
-  Integration method{Integration::kExactArc};  ///< eq 10 (kEuler) or exact arc
+  Integration method{Integration::kExactArc};  ///< exact arc, or kEuler: eq 10 as printed
   /// Covariance of the control (v, w) over a step: (m/s)², (rad/s)².
   Eigen::Matrix<T, 2, 2> control_cov = Eigen::Matrix<T, 2, 2>::Zero();
 

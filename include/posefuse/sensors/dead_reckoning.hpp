@@ -28,15 +28,17 @@ struct PlanarPoseEstimate {
   SampleStatus status{SampleStatus::kOk};  ///< kNonFinite: motion ignored, pose held
 };
 
-/// Odometry-chain stage 3: integrates BodyMotion into a pose (eq 10 or exact
-/// arc) and propagates \f$ P' = J_x P J_x^\top + J_u \Sigma_{\Delta s\Delta\theta} J_u^\top \f$.
+/// Odometry-chain stage 3: integrates BodyMotion into a pose (the exact arc
+/// by default, or eq 10 as printed) and propagates
+/// \f$ P' = J_x P J_x^\top + J_u \Sigma_{\Delta s\Delta\theta} J_u^\top \f$.
 /// Input BodyMotion, Output PlanarPoseEstimate.
 class DeadReckoning {
  public:
   using Input = BodyMotion;
   using Output = PlanarPoseEstimate;
 
-  /// @param[in] method kEuler (eq 10 as printed) or kExactArc
+  /// @param[in] method kExactArc (default, exact for constant v and w over a
+  ///            step) or kEuler (eq 10 as printed, first order)
   /// @param[in] start initial pose (world frame)
   /// @param[in] cov0 initial covariance (a 3x3 Eigen matrix or expression, symmetric PSD)
   /// @throws posefuse::invalid_argument if start or cov0 is not finite, or cov0 not symmetric PSD

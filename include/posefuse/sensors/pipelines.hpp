@@ -8,6 +8,14 @@
 ///  * odometry: WheelSample -> FourWheelAverage (eq 8)
 ///    -> DiffDriveOdometry (eq 9) -> DeadReckoning (eq 10) -> PlanarPoseEstimate.
 ///
+/// The defaults are the sound variants: the gyro rates reach roll and pitch
+/// through the ZYX Euler kinematics (GyroToTiltRate::kEulerKinematics) and
+/// dead reckoning integrates the exact arc (Integration::kExactArc). The
+/// seed's printed forms are options, selected explicitly to reproduce its
+/// figures: GyroToTiltRate::kSeed (eq 3-4 as printed: the body rates taken
+/// for roll and pitch rates, which lags while turning on a tilt) and
+/// Integration::kEuler (eq 10 as printed, first order).
+///
 /// Both start from the library's raw samples (core/samples.hpp, stamped
 /// `t_ns`) and compute every step length from stamp differences with
 /// seconds_between (core/time.hpp), so they run on stamps anywhere in the
@@ -38,10 +46,12 @@ namespace posefuse {
 
 /// Which angular rates drive the roll/pitch prediction of the complementary filter.
 enum class GyroToTiltRate : std::uint8_t {
-  /// Seed 001 eq 3-4 as printed: roll rate = gyro_x, pitch rate = gyro_y
-  /// (right for small tilt).
+  /// Seed 001 eq 3-4 as printed (a reproduction; select it explicitly):
+  /// roll rate = gyro_x, pitch rate = gyro_y. Right only for small tilt:
+  /// turning at a tilt, the yaw rate leaks into roll and pitch.
   kSeed,
-  /// ZYX Euler kinematics: \f$ \dot r = \omega_x + \tan p(\sin r\,\omega_y + \cos r\,\omega_z) \f$,
+  /// ZYX Euler kinematics, the default:
+  /// \f$ \dot r = \omega_x + \tan p(\sin r\,\omega_y + \cos r\,\omega_z) \f$,
   /// \f$ \dot p = \cos r\,\omega_y - \sin r\,\omega_z \f$ (exact at any tilt below 90° pitch).
   kEulerKinematics,
 };
@@ -60,9 +70,10 @@ class ComplementaryTiltStage {
   using Output = TiltedImu;
 
   /// @param[in] alpha filter constant in [0, 1] (seed: gyro weight)
-  /// @param[in] mapping how gyro rates become roll/pitch rates
+  /// @param[in] mapping how gyro rates become roll/pitch rates (kSeed: eq 3-4 as printed)
   /// @throws posefuse::invalid_argument if alpha is outside [0, 1]
-  explicit ComplementaryTiltStage(double alpha, GyroToTiltRate mapping = GyroToTiltRate::kSeed)
+  explicit ComplementaryTiltStage(double alpha,
+                                  GyroToTiltRate mapping = GyroToTiltRate::kEulerKinematics)
       : filter_(alpha), mapping_(mapping) {}
 
   /// @throws posefuse::invalid_argument if the stamp is not later than the
@@ -105,10 +116,11 @@ class ComplementaryTiltStage {
 
 /// Configuration of the attitude chain.
 struct AttitudeConfig {
-  double alpha{0.98};                                 ///< complementary filter constant, [0, 1]
-  GyroToTiltRate gyro_mapping{GyroToTiltRate::kSeed};  ///< eq 3-4 as printed by default
-  MagnetometerCalibration calibration{};              ///< hard/soft iron (identity by default)
-  double declination_rad{0.0};                        ///< added to the magnetic yaw, rad
+  double alpha{0.98};  ///< complementary filter constant, [0, 1]
+  /// Euler kinematics by default; kSeed reproduces eq 3-4 as printed.
+  GyroToTiltRate gyro_mapping{GyroToTiltRate::kEulerKinematics};
+  MagnetometerCalibration calibration{};  ///< hard/soft iron (identity by default)
+  double declination_rad{0.0};            ///< added to the magnetic yaw, rad
 };
 
 /// ImuSample -> Attitude (seed 001 eq 1-7).
@@ -129,7 +141,7 @@ using OdometryPipeline = Pipeline<FourWheelAverage, DiffDriveOdometry, DeadRecko
 /// Builds the odometry chain; `stage<2>()` is the DeadReckoning (for reset()).
 /// @param[in] params robot geometry
 /// @param[in] noise per-wheel encoder noise
-/// @param[in] method kEuler (eq 10 as printed) or kExactArc
+/// @param[in] method kExactArc (default) or kEuler (eq 10 as printed)
 /// @param[in] start initial pose, world frame
 /// @param[in] cov0 initial pose covariance (3x3; a template only so that
 ///            including this header does not compile DeadReckoning's check)
