@@ -1,4 +1,4 @@
-// corridor_fusion — seed 001's corridor experiment (SPEC.md §B, issue 3 item 8).
+// corridor_fusion — seed 001's corridor experiment.
 //
 // Scenario: a four-wheel robot drives a 14 m x 9 m corridor loop counter-
 // clockwise from point 1 and back. ORB-SLAM alone loses tracking at the

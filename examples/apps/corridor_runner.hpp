@@ -15,8 +15,9 @@
 ///
 /// **Chains.** Odometry: wheels.csv → eq 8 → eq 9 → dead reckoning (eq 10,
 /// Euler as printed, by default) = (x, y, θ_enc). Attitude: imu.csv → eq 1-2
-/// → complementary filter eq 3-4 (robot.txt alpha) → tilt-compensated compass
-/// (eq 5-7 corrected) = (roll, pitch, yaw). The log carries no magnetometer
+/// → complementary filter eq 3-4 as printed (GyroToTiltRate::kSeed;
+/// robot.txt alpha) → tilt-compensated compass (eq 5-7 corrected)
+/// = (roll, pitch, yaw). The log carries no magnetometer
 /// calibration, so the runner fits hard and soft iron in the horizontal
 /// plane (fit_horizontal_ellipse, sensors/magnetometer_calibration.hpp: an
 /// ellipse through all readings; a ground robot turns about z only, which
@@ -104,7 +105,7 @@ inline constexpr std::array<const char*, 4> kCorridorMethodNames{"slam_only", "o
 
 /// Options of run_corridor(); the defaults are the documented configuration.
 struct CorridorRunConfig {
-  Integration integration = Integration::kEuler;  ///< eq 10 as printed
+  Integration integration = Integration::kEuler;  ///< eq 10 as printed (the seed's choice)
   WheelNoiseParams wheel_noise{};                 ///< dead-reckoning covariance (not used by the methods)
   GatedFuserParams<double> gated{};               ///< the sound fuser
   double slam_stale_s = 0.3;       ///< seed fuser: SLAM older than this → O_r = O_m (s)
@@ -547,7 +548,9 @@ inline void evaluate_methods(CorridorRunResult& res, const CorridorRunConfig& cf
   res.magnetometer = mag.calibration;
   res.magnetometer_calibrated = mag.calibrated;
   res.magnetometer_note = std::move(mag.note);
-  const AttitudeConfig att_cfg{log.params.complementary_alpha, GyroToTiltRate::kSeed, res.magnetometer, 0.0};
+  // The seed's eq 3-4 as printed (the library's default is the Euler kinematics).
+  const AttitudeConfig att_cfg{log.params.complementary_alpha, GyroToTiltRate::kSeed,
+                               res.magnetometer, 0.0};
   const DiffDriveParams dd{log.params.ticks_per_rev, log.params.wheel_radius_m, log.params.track_width_m};
   res.heading_offset_rad = compass_heading_offset(log, att_cfg, dd, cfg, clock);
   res.attitude_max_age_s = attitude_max_age(log, cfg, clock);
