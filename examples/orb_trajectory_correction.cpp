@@ -1,13 +1,13 @@
 // orb_trajectory_correction: seed 000's EKF post-processing of a SLAM
 // trajectory on the road plane, with the models that go beyond it.
 //
-// Scenario (seed 000, SPEC.md A): ORB-SLAM ran unchanged; its output
+// Scenario (seed 000, docs/reproductions.md): ORB-SLAM ran unchanged; its output
 // trajectory is filtered on the road plane and the planar RMSE against ground
 // truth is compared before and after (seed 000, Table 1). Three correctors:
 //
 //   seed000   the seed's EKF exactly: x = [x, y], u = SLAM displacement,
 //             z = SLAM position, G = H = I, R (process) and Q (measurement).
-//             It returns its input (SPEC.md A), so its reduction is 0 %.
+//             It returns its input (docs/reproductions.md), so its reduction is 0 %.
 //   cv        a constant-velocity EKF (own dynamics) on the SLAM positions.
 //   cv+rts    the same run smoothed offline (Rauch-Tung-Striebel).
 //
@@ -16,14 +16,14 @@
 // include/posefuse/sim/kitti_like_drive.hpp) and prints:
 //
 //   estimate     method    RMSE before [m]  RMSE after [m]  reduction   verdict
-//   synthetic    seed000             1.150           1.150     0.00 %   returns its input (SPEC.md A)
+//   synthetic    seed000             1.150           1.150     0.00 %   returns its input (docs/reproductions.md)
 //   synthetic    cv                  1.150           1.143     0.60 %   no real gain
 //   synthetic    cv+rts              1.150           1.049     8.72 %   helps
 //
 // On KITTI 06 none of them reduces the error of ORB-SLAM2 stereo (0.874 m
 // before; seed000 0 %, cv -8 %, cv+rts -0.05 %): its error is drift.
 //
-// On KITTI 06 (../shared/data/kitti/06):
+// On KITTI 06 (kitti/06 of the data folder, docs/programs.md):
 //
 //   orb_trajectory_correction --groundtruth groundtruth.txt --times times.txt
 //       --estimate orbslam2_stereo.txt --estimate cvo_vo.txt --plot kitti06.svg
@@ -269,7 +269,7 @@ std::optional<double> reduction_percent(double before, double after) {
 std::string verdict(const std::string& method, double before, double after) {
   const std::optional<double> red = reduction_percent(before, after);
   if (!red) return "worse than raw";
-  if (method == "seed000" && std::abs(*red) < 1e-6) return "returns its input (SPEC.md A)";
+  if (method == "seed000" && std::abs(*red) < 1e-6) return "returns its input (docs/reproductions.md)";
   if (*red >= 1.0) return "helps";
   if (*red > -1.0) return "no real gain";
   return "worse than raw";
@@ -373,7 +373,7 @@ void print_table(const Options& o, const std::vector<EstimateResult>& results) {
               "(|dP/dframe| < 0.01) at %.4f m^2 from frame %zu.\n",
               results.front().methods[0].variance.front(), steady_value, steady_frame);
   std::printf("seed000 returns its input whatever R and Q (u = z_t - z_{t-1} cancels the gain; "
-              "SPEC.md A).\n");
+              "docs/reproductions.md).\n");
 }
 
 int run(const Options& o) {

@@ -10,7 +10,7 @@
 ///
 /// with state \f$ \mu = [x, y] \f$, control \f$ u_t = z_t - z_{t-1} \f$ (the SLAM's
 /// frame-to-frame displacement), measurement \f$ z_t \f$ (the SLAM position) and
-/// \f$ G = H = I \f$. As SPEC.md shows, the error \f$ e_t = \mu_t - z_t \f$ then obeys
+/// \f$ G = H = I \f$. As docs/reproductions.md shows, the error \f$ e_t = \mu_t - z_t \f$ then obeys
 /// \f$ e_t = (I - K_t) e_{t-1} \f$, so a filter started at \f$ z_0 \f$ returns its
 /// input exactly, for every R and Q. `make_seed000_corrector` reproduces that.
 ///

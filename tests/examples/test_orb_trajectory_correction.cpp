@@ -59,7 +59,7 @@ TEST_CASE("orb_trajectory_correction: built-in drive reproduces the seed-000 ide
   CHECK(methods[2]["method"].string() == "cv+rts");
   CHECK(methods[0]["reduction_percent"].number() == Approx(0.0).margin(1e-9));
   CHECK(methods[0]["rmse_after"].number() == Approx(e["rmse_before"].number()).epsilon(1e-12));
-  CHECK(methods[0]["verdict"].string() == "returns its input (SPEC.md A)");
+  CHECK(methods[0]["verdict"].string() == "returns its input (docs/reproductions.md)");
   CHECK(methods[2]["reduction_percent"].number() > 3.0);  // smoothing removes the jitter
   CHECK(j["seed000_covariance"]["initial"].number() == 1.0);
   CHECK(j["seed000_covariance"]["steady_frame"].number() >= 1);
@@ -70,7 +70,7 @@ TEST_CASE("orb_trajectory_correction: built-in drive reproduces the seed-000 ide
   CHECK(table.out.find("returns its input") != std::string::npos);
 }
 
-TEST_CASE("orb_trajectory_correction: README's table and the example's comment are its output",
+TEST_CASE("orb_trajectory_correction: docs/reproductions.md's table and the example's comment are its output",
           "[examples][seed000]") {
   POSEFUSE_REQUIRE_EXAMPLE(exe, "orb_trajectory_correction");
   posefuse::test::TempDir dir("orb");
@@ -84,11 +84,11 @@ TEST_CASE("orb_trajectory_correction: README's table and the example's comment a
   REQUIRE(rows.size() == 3);
   const std::filesystem::path root =
       std::filesystem::path(__FILE__).parent_path().parent_path().parent_path();
-  const std::string readme = posefuse::test::slurp(root / "README.md");
+  const std::string page = posefuse::test::slurp(root / "docs" / "reproductions.md");
   const std::string example = posefuse::test::slurp(root / "examples" / "orb_trajectory_correction.cpp");
   for (const std::string& row : rows) {
     INFO(row);
-    CHECK(readme.find(row) != std::string::npos);
+    CHECK(page.find(row) != std::string::npos);
     // The example's comment drops 10 columns of padding after "synthetic".
     CHECK(example.find("//   " + row.substr(0, 13) + row.substr(23)) != std::string::npos);
   }
@@ -182,7 +182,7 @@ TEST_CASE("orb_trajectory_correction: zero error before gives a defined reductio
   REQUIRE(table.status == 0);
   CHECK_FALSE(has_non_finite(table.out));
   CHECK(table.out.find("gt                     seed000             0.000           0.000     0.00 %   "
-                       "returns its input (SPEC.md A)") != std::string::npos);
+                       "returns its input (docs/reproductions.md)") != std::string::npos);
   CHECK(table.out.find("n/a   worse than raw") != std::string::npos);  // cv moves off the truth
   const auto json = posefuse::test::run(exe, args + " --json", dir);
   REQUIRE(json.status == 0);
