@@ -2,7 +2,7 @@
 // `evaluate_trajectory --save-results FILE` side by side, as evo_res does.
 //
 // Scenario: two estimators on KITTI 06, each evaluated and saved, then
-// compared (../shared/data, see its README):
+// compared (paths in the data folder, docs/programs.md):
 //
 //   evaluate_trajectory --groundtruth kitti/06/groundtruth.txt
 //       --estimate kitti/06/orbslam2_stereo.txt --align se3 --save-results orb.json

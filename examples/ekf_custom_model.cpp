@@ -14,7 +14,7 @@
 //   beacon updates: 237 applied, 3 rejected
 //   position RMSE: dead reckoning 3.381 m, EKF 0.136 m
 //
-// (README's "Write your own model" walks through it; the test
+// (docs/writing-models.md walks through it; the test
 // tests/examples/test_ekf_custom_model.cpp checks that this is the output.)
 #include <cmath>
 #include <numbers>

@@ -2,8 +2,8 @@
 // against ground truth, with posefuse's readers, association, Umeyama
 // alignment and metrics (numbers agree with evo_ape / evo_rpe).
 //
-// Scenario: score ORB-SLAM2 on KITTI odometry sequence 06 (../shared/data,
-// see its README). Stereo output is metric, so align with SE(3):
+// Scenario: score ORB-SLAM2 on KITTI odometry sequence 06 (kitti/06 of the
+// data folder, docs/programs.md). Stereo output is metric, so align with SE(3):
 //
 //   evaluate_trajectory --groundtruth kitti/06/groundtruth.txt
 //                       --estimate kitti/06/orbslam2_stereo.txt --align se3
@@ -32,7 +32,7 @@
 // --delta-unit m for the relative error per 100 m, --json for machine-readable
 // output, --plot FILE.svg for a picture, --save-results FILE to keep everything (statistics, per-pose errors,
 // options) as JSON. evo_ape / evo_rpe options are spelled with dashes
-// (--t-offset, --align-origin, --n-to-align, ...; see --help and README).
+// (--t-offset, --align-origin, --n-to-align, ...; see --help and docs/evaluation.md).
 // Repeated timestamps are kept first by default (--duplicates) and reported
 // as a "warning:" line on stderr. Bad input exits with 2 (usage) or 1 (data,
 // naming file:line where a file is at fault), one line on stderr.
@@ -204,7 +204,7 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
       "otherwise poses are associated by timestamp like evo's --t_max_diff.\n"
       "Order as evo: --downsample/--motion-filter, --t-start/--t-end (REF),\n"
       "association (--t-offset), alignment, --project-to-plane, metric.\n"
-      "A TUM estimate may carry a covariance per pose (14 or 29 columns, README):\n"
+      "A TUM estimate may carry a covariance per pose (14 or 29 columns, docs/programs.md):\n"
       "APE then also reports NEES with its chi-square bounds.\n"
       "Exit status: 0 ok, 1 bad data (file:line where a file is at fault), 2 bad usage.");
   if (!cli.parse(cmd)) return std::nullopt;

@@ -2,7 +2,7 @@
 // against the ground-truth relative motion of a real recording, and whether
 // its errors are consistent with the propagated covariance.
 //
-// Scenario: EuRoC V1_01_easy (../shared/data/euroc, see its README). Cut the
+// Scenario: EuRoC V1_01_easy (euroc/ of the data folder, docs/programs.md). Cut the
 // sequence into consecutive windows of S seconds that start and end on
 // ground-truth states i, j (the IMU stream is interpolated at those stamps);
 // pre-integrate the IMU with the ground-truth biases of state i; compare
@@ -15,7 +15,7 @@
 //   imu_preintegration_check --imu euroc/V1_01_easy/imu0.csv
 //                            --groundtruth euroc/V1_01_easy/groundtruth_20hz.csv --window 1
 //
-// Expected output (format; the figures are in README, "Seed 003"):
+// Expected output (format; the figures are in docs/inertial.md):
 //
 //   IMU pre-integration vs ground truth: 143 windows of 1 s (0 skipped)
 //   error                 rmse    median       p95       max

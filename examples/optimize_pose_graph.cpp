@@ -1,5 +1,5 @@
 // optimize_pose_graph: optimises a planar g2o pose graph with posefuse's
-// 4-DoF pose graph (seed 003, SPEC.md C; a planar graph is the 4-DoF graph
+// 4-DoF pose graph (seed 003, docs/pose-graph.md; a planar graph is the 4-DoF graph
 // with z = 0) and reports g2o's chi2 before and after.
 //
 // Scenario: a SLAM back end hands over a g2o file (VERTEX_SE2 / EDGE_SE2).
@@ -17,7 +17,7 @@
 //   input        nodes  edges  init           initial_cost   final_cost   iterations  solve_time_s
 //   built-in      2000   2449  rotation-first     3.5e+07       2364.1         4        0.01
 //
-// On the public graphs (../shared/data/posegraph):
+// On the public graphs (posegraph/ of the data folder, docs/programs.md):
 //
 //   optimize_pose_graph --input manhattanOlson3500.g2o
 //       --groundtruth manhattanOlson3500_groundtruth.txt --out manhattan_opt.g2o

@@ -1,6 +1,6 @@
 // pose_graph_correction: corrects a drifting odometry trajectory with loop
 // closures on posefuse's 4-DoF pose graph (VINS-Mono's global pose graph,
-// seed 003, SPEC.md C) and compares the absolute position error before and
+// seed 003, docs/pose-graph.md) and compares the absolute position error before and
 // after.
 //
 // Scenario: a visual(-inertial) odometry ran; its trajectory drifts in x, y,
@@ -23,7 +23,7 @@
 //   input       frames  loops  outliers  APE se3 before  after  APE posyaw before  after
 //   simulated     1000    225         5           ...     ...             ...      ...
 //
-// On KITTI 06 (../shared/data/kitti/06):
+// On KITTI 06 (kitti/06 of the data folder, docs/programs.md):
 //
 //   pose_graph_correction --odometry cvo_vo.txt --groundtruth groundtruth.txt
 //       --oracle-loops --outliers 10 --out corrected.txt --svg kitti06_graph.svg

@@ -2,7 +2,7 @@
 // a real IMU recording, with the ground truth turned into an up-to-scale
 // stand-in for vision-only SfM.
 //
-// Scenario: EuRoC V1_01_easy (../shared/data/euroc). Keyframes every
+// Scenario: EuRoC V1_01_easy (euroc/ of the data folder). Keyframes every
 // --keyframe-interval seconds (default 0.25 s, on ground-truth stamps);
 // sliding windows of 10 keyframes, starting every --stride keyframes. In each
 // window the camera poses T_c0_ck come from the ground-truth body poses and
@@ -21,7 +21,7 @@
 //   vi_alignment_check --imu euroc/V1_01_easy/imu0.csv
 //                      --groundtruth euroc/V1_01_easy/groundtruth_20hz.csv
 //
-// Expected output (format; figures in README, "Seed 003"):
+// Expected output (format; figures in docs/inertial.md):
 //
 //   Visual-inertial alignment, windows of 10 keyframes 0.25 s apart: ... windows
 //   status: ok ..., insufficient excitation ..., ...
