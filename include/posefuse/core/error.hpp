@@ -2,10 +2,11 @@
 /// @file
 /// The library's exception types and its debug assertion.
 ///
-/// posefuse reports three kinds of failure differently (see STYLE.md §5):
-/// bad configuration throws posefuse::invalid_argument, unreadable or
-/// malformed files throw posefuse::io_error naming the file and line, and
-/// data failures on a per-sample hot path return a [[nodiscard]] status.
+/// posefuse reports three kinds of failure differently (docs/design.md,
+/// "Errors"): bad configuration throws posefuse::invalid_argument, unreadable
+/// or malformed files throw posefuse::io_error naming the file and line, and
+/// data failures on a per-sample hot path return a [[nodiscard]] status
+/// (core/status.hpp).
 
 #include <cstddef>
 #include <filesystem>

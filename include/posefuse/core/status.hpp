@@ -3,8 +3,9 @@
 /// The outcome of one estimator step, shared by every filter and fuser.
 ///
 /// A step either applies (state and covariance change) or reports why not
-/// and leaves the estimator exactly as it was (STYLE.md §5: hot-path data
-/// failures are statuses, never exceptions or silently propagated NaN).
+/// and leaves the estimator exactly as it was: hot-path data failures are
+/// statuses, never exceptions or silently propagated NaN (docs/design.md,
+/// "Errors").
 
 namespace posefuse {
 
