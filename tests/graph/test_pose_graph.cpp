@@ -466,7 +466,7 @@ TEST_CASE("PoseGraph4Dof: the planar path equals the 4-DoF path on a planar grap
   }
   CHECK(worst < 1e-10);
   // Solving again after the buffers were released gives the same answer.
-  PoseGraph4Dof::release_workspace();
+  a.release_workspace();
   PoseGraph4Dof a2 = start_graph;
   const PoseGraphSummary sa2 = a2.optimize(planar);
   CHECK(sa2.final_cost == sa.final_cost);

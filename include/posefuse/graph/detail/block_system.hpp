@@ -172,6 +172,13 @@ class BlockSystem {
     }
     return H;
   }
+  /// Bytes of heap storage held (capacity, including build() scratch).
+  [[nodiscard]] std::size_t capacity_bytes() const noexcept {
+    const std::size_t ints = colptr.capacity() + rowidx.capacity() + slot_.capacity() + work_.capacity() +
+                             by_row_.capacity() + next_.capacity() + remap_.capacity();
+    return sizeof(int) * ints + sizeof(Block) * (off.capacity() + diag.capacity()) +
+           sizeof(double) * std::size_t(b.size()) + sizeof(std::pair<int, int>) * pairs_.capacity();
+  }
   /// \f$ x^\top H x \f$.
   [[nodiscard]] double quadratic_form(const Eigen::VectorXd& x) const {
     double q = 0.0;
@@ -325,6 +332,13 @@ class BlockCholesky {
 
   /// Number of strictly lower blocks of L.
   [[nodiscard]] std::size_t factor_blocks() const noexcept { return Li_.size(); }
+
+  /// Bytes of heap storage held (capacity, the factor and its work arrays).
+  [[nodiscard]] std::size_t capacity_bytes() const noexcept {
+    const std::size_t ints = parent_.capacity() + Lp_.capacity() + Li_.capacity() + stack_.capacity() +
+                             mark_.capacity() + path_.capacity() + next_.capacity();
+    return sizeof(int) * ints + sizeof(Block) * (Lx_.capacity() + Ldinv_.capacity() + x_.capacity());
+  }
 
  private:
   /// Pattern of row k of L in topological order: stack_[top .. n) (Davis Alg. 4.2).
