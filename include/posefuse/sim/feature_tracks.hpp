@@ -24,9 +24,9 @@
 /// together. When fewer than `features_per_frame` tracks go on, new ones
 /// start on seen, untracked landmarks in a random order, each at least
 /// `min_feature_distance_px` from every other tracked feature (as a front
-/// end's detection mask); a new track gets the next id (0, 1, 2, ...: ids
-/// are never reused, a landmark seen again after its track ended gets a new
-/// id).
+/// end's detection mask); a track gets the next id (0, 1, 2, ...) with its
+/// first written observation: ids are never reused (a landmark seen again
+/// after its track ended gets a new id) and every id appears in the output.
 ///
 /// **Observations.** Each observation is, with probability
 /// `outlier_fraction` and independently of the others, a **wrong
@@ -46,6 +46,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -124,7 +125,7 @@ struct SimulatedTracks {
   std::vector<Eigen::Isometry3d> T_W_B;       ///< body pose at each frame
   std::vector<Eigen::Vector3d> landmarks_w;   ///< landmarks: walls first, then free points (m)
   std::size_t wall_landmarks = 0;             ///< landmarks_w[0, wall_landmarks) lie on walls
-  std::vector<std::size_t> landmark_of_id;    ///< landmark_of_id[id]: the landmark of track id
+  std::vector<std::size_t> landmark_of_id;    ///< landmark_of_id[id]: the landmark of track id (one per track)
   std::size_t observations = 0;               ///< observations written
   std::size_t wrong_associations = 0;         ///< of which wrong associations
   std::size_t frames_below_target = 0;        ///< frames with fewer than features_per_frame features
@@ -187,6 +188,19 @@ struct SimulatedTracks {
   const auto target = std::size_t(config.features_per_frame);
   const double sigma = config.pixel_noise_px, min_err = config.outlier_min_error_px;
 
+  // A box around the image's undistorted border (2 % wider): points outside
+  // it cannot project into the image, so most are rejected before project().
+  double x_max = 0, y_max = 0;
+  for (int i = 0; i <= 64; ++i) {
+    const double a = i / 64.0;
+    for (const Eigen::Vector2d& uv :
+         {Eigen::Vector2d(-0.5 + a * camera.width, -0.5), Eigen::Vector2d(-0.5 + a * camera.width, camera.height - 0.5),
+          Eigen::Vector2d(-0.5, -0.5 + a * camera.height), Eigen::Vector2d(camera.width - 0.5, -0.5 + a * camera.height)}) {
+      const Eigen::Vector2d xy = camera.undistort(uv);
+      x_max = std::max(x_max, 1.02 * std::abs(xy.x()));
+      y_max = std::max(y_max, 1.02 * std::abs(xy.y()));
+    }
+  }
   out.tracks.reserve(t_ns.size());
   out.truth.reserve(t_ns.size());
   for (std::size_t k = 0; k < t_ns.size(); ++k) {
@@ -196,7 +210,9 @@ struct SimulatedTracks {
     for (std::size_t i = 0; i < L; ++i) {
       const Eigen::Vector3d p_C = R_CW * (out.landmarks_w[i] - c_W);
       seen[i] = 0;
-      if (!(p_C.z() >= config.min_depth_m)) continue;
+      if (!(p_C.z() >= config.min_depth_m) || std::abs(p_C.x()) > x_max * p_C.z() ||
+          std::abs(p_C.y()) > y_max * p_C.z())
+        continue;
       const std::optional<Eigen::Vector2d> uv = camera.project(p_C);
       if (!uv) continue;
       proj[i] = *uv;
@@ -222,10 +238,10 @@ struct SimulatedTracks {
       for (const std::size_t i : candidates) {
         if (next.size() >= target) break;
         if (!grid.free_at(proj[i])) continue;
-        const auto id = std::uint64_t(out.landmark_of_id.size());
-        out.landmark_of_id.push_back(i);
+        // The id is given with the first observation written (below), so
+        // that ids are 0, 1, 2, ... without holes.
         const int limit = limit_lo + int(rng.below(std::size_t(config.max_track_length - limit_lo + 1)));
-        next.push_back(Track{i, id, 0, limit});
+        next.push_back(Track{i, 0, 0, limit});
         tracked[i] = 1;
         grid.add(proj[i]);
       }
@@ -261,6 +277,10 @@ struct SimulatedTracks {
       if (!camera.in_image(uv)) {
         tracked[t.landmark] = 0;
         continue;
+      }
+      if (t.length == 0) {
+        t.id = std::uint64_t(out.landmark_of_id.size());
+        out.landmark_of_id.push_back(t.landmark);
       }
       ++t.length;
       frame.features.push_back(FeatureObservation{t.id, uv});

@@ -1,0 +1,202 @@
+// simulate_tracks: feature tracks (t_ns,feature_id,u,v csv, docs/feature-tracks.md)
+// that a visual front end would report for a camera moving along a
+// trajectory through a room of point landmarks (sim/feature_tracks.hpp).
+//
+// Semi-real sequences: the real motion of a EuRoC recording and its real IMU,
+// with synthetic vision:
+//
+//   simulate_tracks --groundtruth V1_01_easy/groundtruth_20hz.csv
+//                   --camera V1_01_easy/cam0_sensor.yaml --out cam0_tracks.csv
+//
+// Without --groundtruth the camera flies the built-in synthetic flight
+// (sim::synthetic_flight, --duration seconds) and --groundtruth-out /
+// --imu-out write its ground truth and a simulated IMU (EuRoC csv layouts),
+// so that a whole synthetic sequence can be made.
+//
+// Prints one summary (or --json one object): frames, observations per frame,
+// wrong associations, tracks and their mean length, landmarks. Exit status:
+// 0 ok, 1 bad data (file:line where a file is at fault), 2 bad usage.
+
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <apps/cli.hpp>
+#include <apps/json.hpp>
+#include <apps/output_file.hpp>
+#include <posefuse/io/detail/text.hpp>
+#include <posefuse/io/euroc.hpp>
+#include <posefuse/io/feature_tracks.hpp>
+#include <posefuse/sim/feature_tracks.hpp>
+#include <posefuse/sim/imu.hpp>
+#include <posefuse/vio/camera.hpp>
+
+namespace {
+
+namespace apps = posefuse::apps;
+namespace sim = posefuse::sim;
+
+struct Options {
+  std::optional<std::filesystem::path> groundtruth, camera, out, groundtruth_out, imu_out;
+  sim::TrackSimConfig config;
+  double duration_s = 60.0;
+  bool json = false;
+};
+
+std::optional<Options> parse_options(const apps::CommandLine& cmd) {
+  Options o;
+  sim::TrackSimConfig& c = o.config;
+  apps::Parser cli(cmd.program,
+                   "--out FILE [--groundtruth FILE --camera FILE | --duration S] [options]",
+                   "Simulates the feature tracks of a camera moving along a EuRoC ground truth "
+                   "(or the built-in synthetic flight) through a room of point landmarks, and "
+                   "writes them as t_ns,feature_id,u,v csv. The vision is synthetic; with a real "
+                   "ground truth and its IMU the sequence is semi-real.");
+  cli.path({.name = "--out", .value = "FILE", .help = "feature-track csv to write (required)"}, o.out);
+  cli.path({.name = "--groundtruth", .value = "FILE",
+            .help = "EuRoC ground truth csv (8 or 17 columns): the motion\n(default: the synthetic flight)"},
+           o.groundtruth);
+  cli.path({.name = "--camera", .value = "FILE",
+            .help = "EuRoC camera sensor.yaml (required with --groundtruth;\ndefault: EuRoC cam0 intrinsics looking along body x)"},
+           o.camera);
+  cli.real({.name = "--rate", .value = "HZ", .help = "frame rate", .unit = "Hz"}, c.rate_hz,
+           apps::Domain::kPositive);
+  cli.real({.name = "--noise-px", .value = "S", .help = "pixel noise sigma per axis", .unit = "px"},
+           c.pixel_noise_px, apps::Domain::kNonNegative);
+  cli.real({.name = "--outliers", .value = "F", .help = "fraction of wrong associations, in [0, 1)"},
+           c.outlier_fraction, apps::Domain::kNonNegative);
+  cli.integer({.name = "--features", .value = "N", .help = "tracked features wanted per frame"},
+              c.features_per_frame, 1, 100000);
+  cli.integer({.name = "--max-track-length", .value = "N", .help = "longest track (frames)"},
+              c.max_track_length, 2, 1000000);
+  cli.real({.name = "--min-distance", .value = "PX", .help = "new features this far from tracked ones",
+            .unit = "px"},
+           c.min_feature_distance_px, apps::Domain::kNonNegative);
+  cli.real({.name = "--room-margin", .value = "M", .help = "walls beyond the path's bounding box", .unit = "m"},
+           c.room_margin_m, apps::Domain::kPositive);
+  cli.real({.name = "--wall-density", .value = "D", .help = "wall landmarks per square metre"},
+           c.wall_density_per_m2, apps::Domain::kNonNegative);
+  cli.integer({.name = "--free-points", .value = "N", .help = "free landmarks inside the room"}, c.free_points,
+              0, 10000000);
+  cli.real({.name = "--max-pose-gap", .value = "S", .help = "longest ground-truth interval a frame may be\ninterpolated across",
+            .unit = "s"},
+           c.max_pose_gap_s, apps::Domain::kPositive);
+  cli.integer({.name = "--seed", .value = "N", .help = "random seed"}, c.seed);
+  cli.real({.name = "--duration", .value = "S", .help = "synthetic flight length", .unit = "s"}, o.duration_s,
+           apps::Domain::kPositive);
+  cli.path({.name = "--groundtruth-out", .value = "FILE",
+            .help = "synthetic flight only: write its ground truth (EuRoC csv,\n17 columns, 200 Hz)"},
+           o.groundtruth_out);
+  cli.path({.name = "--imu-out", .value = "FILE",
+            .help = "synthetic flight only: write a simulated IMU (EuRoC imu0 csv,\n200 Hz, EuRoC ADIS16448 noise, seeded with --seed)"},
+           o.imu_out);
+  cli.flag({.name = "--json", .help = "print one JSON object instead of the summary"}, o.json);
+  cli.epilogue("Exit status: 0 ok, 1 bad data (file:line where a file is at fault), 2 bad usage.");
+  if (!cli.parse(cmd)) return std::nullopt;
+  if (!o.out) throw apps::usage_error("--out is required");
+  if (o.groundtruth && !o.camera) throw apps::usage_error("--groundtruth needs --camera");
+  if (o.groundtruth && (o.groundtruth_out || o.imu_out || cli.given("--duration")))
+    throw apps::usage_error("--duration, --groundtruth-out and --imu-out are for the synthetic flight only");
+  try {
+    c.validate();
+  } catch (const posefuse::invalid_argument& e) {
+    throw apps::usage_error(e.what());
+  }
+  return o;
+}
+
+std::string num(double v) { return posefuse::detail::traj_io::format_number(v); }
+
+std::string groundtruth_csv(const posefuse::EurocGroundTruth& gt) {
+  std::string s = "#timestamp,p_x,p_y,p_z,q_w,q_x,q_y,q_z,v_x,v_y,v_z,bw_x,bw_y,bw_z,ba_x,ba_y,ba_z\n";
+  for (std::size_t k = 0; k < gt.size(); ++k) {
+    const Eigen::Isometry3d& T = gt.trajectory.poses[k];
+    const Eigen::Quaterniond q(T.linear());
+    const Eigen::Vector3d p = T.translation(), v = (*gt.velocity)[k], bw = (*gt.gyro_bias)[k],
+                          ba = (*gt.accel_bias)[k];
+    s += std::to_string(gt.t_ns[k]);
+    for (const double x : {p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z(), v.x(), v.y(), v.z(), bw.x(), bw.y(),
+                           bw.z(), ba.x(), ba.y(), ba.z()})
+      s += "," + num(x);
+    s += "\n";
+  }
+  return s;
+}
+
+std::string imu_csv(const std::vector<posefuse::ImuSample>& imu) {
+  std::string s = "#timestamp [ns],w_x [rad s^-1],w_y,w_z,a_x [m s^-2],a_y,a_z\n";
+  for (const posefuse::ImuSample& m : imu) {
+    s += std::to_string(m.t_ns);
+    for (const double x : {m.gyro_radps.x(), m.gyro_radps.y(), m.gyro_radps.z(), m.accel_mps2.x(),
+                           m.accel_mps2.y(), m.accel_mps2.z()})
+      s += "," + num(x);
+    s += "\n";
+  }
+  return s;
+}
+
+int run(const Options& o) {
+  const posefuse::PinholeRadtan camera =
+      o.camera ? posefuse::read_euroc_camera(*o.camera) : sim::synthetic_camera();
+  sim::SimulatedTracks s;
+  apps::OutputFiles files;
+  if (o.groundtruth) {
+    const posefuse::EurocGroundTruth gt = posefuse::read_euroc_groundtruth(*o.groundtruth);
+    try {
+      s = sim::simulate_feature_tracks(gt, camera, o.config);
+    } catch (const posefuse::invalid_argument& e) {
+      throw posefuse::io_error(*o.groundtruth, e.what());
+    }
+  } else {
+    posefuse::sim::ImuSimConfig flight = sim::synthetic_flight();
+    s = sim::simulate_feature_tracks(flight, o.duration_s, camera, o.config);
+    if (o.groundtruth_out)
+      files.add(*o.groundtruth_out, groundtruth_csv(sim::synthetic_groundtruth(flight, o.duration_s, 200.0)));
+    if (o.imu_out) {
+      flight.noise = posefuse::ImuNoise{};
+      flight.seed = o.config.seed;
+      files.add(*o.imu_out, imu_csv(sim::simulate_imu(flight, o.duration_s).samples));
+    }
+  }
+  files.add_with(*o.out, [&s](const std::filesystem::path& p) { posefuse::write_feature_tracks(p, s.tracks); });
+  files.commit();
+
+  const double frames = double(s.tracks.size());
+  const double per_frame = frames > 0 ? double(s.observations) / frames : 0.0;
+  const double wrong = s.observations > 0 ? double(s.wrong_associations) / double(s.observations) : 0.0;
+  const double mean_length =
+      s.landmark_of_id.empty() ? 0.0 : double(s.observations) / double(s.landmark_of_id.size());
+  if (o.json) {
+    apps::JsonWriter j(std::cout);
+    j.begin_object(apps::JsonWriter::Layout::kInline);
+    j.member("frames", s.tracks.size()).member("observations", s.observations);
+    j.member("features_per_frame", per_frame).member("frames_below_target", s.frames_below_target);
+    j.member("wrong_association_fraction", wrong).member("tracks", s.landmark_of_id.size());
+    j.member("mean_track_length", mean_length).member("landmarks", s.landmarks_w.size());
+    j.member("wall_landmarks", s.wall_landmarks);
+    j.end_object().finish();
+  } else {
+    std::printf("%zu frames at %g Hz, %zu observations (%.1f per frame, %zu frames below %d)\n",
+                s.tracks.size(), o.config.rate_hz, s.observations, per_frame, s.frames_below_target,
+                o.config.features_per_frame);
+    std::printf("%zu tracks, mean length %.1f frames; wrong associations %.2f %%; pixel noise %g px\n",
+                s.landmark_of_id.size(), mean_length, 100.0 * wrong, o.config.pixel_noise_px);
+    std::printf("%zu landmarks (%zu on walls, %zu free); vision synthetic, motion %s\n", s.landmarks_w.size(),
+                s.wall_landmarks, s.landmarks_w.size() - s.wall_landmarks,
+                o.groundtruth ? "from the ground truth" : "the synthetic flight");
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return apps::run_main(argc, argv, [](const apps::CommandLine& cmd) {
+    const std::optional<Options> o = parse_options(cmd);
+    return o ? run(*o) : 0;
+  });
+}
