@@ -12,6 +12,7 @@
 #include <posefuse/lie/rotation.hpp>
 #include <posefuse/filters/complementary.hpp>
 #include <posefuse/models/unicycle.hpp>
+#include <posefuse/seed/tilt_compensated_heading.hpp>
 #include <posefuse/sensors/compass.hpp>
 #include <posefuse/sensors/dead_reckoning.hpp>
 #include <posefuse/sensors/pipelines.hpp>
@@ -77,7 +78,7 @@ void compass_bench(benchmark::State& state) {
   std::size_t k = 0;
   for (auto _ : state) {
     if constexpr (kSeed) {
-      benchmark::DoNotOptimize(posefuse::tilt_compensated_heading_seed(mag[k], tilt[k].roll, tilt[k].pitch));
+      benchmark::DoNotOptimize(posefuse::seed::tilt_compensated_heading_seed(mag[k], tilt[k].roll, tilt[k].pitch));
     } else {
       benchmark::DoNotOptimize(posefuse::tilt_compensated_heading(mag[k], tilt[k].roll, tilt[k].pitch));
     }
@@ -154,7 +155,9 @@ BENCHMARK(BM_DeadReckoning_StepWithCovariance)->Arg(0)->Arg(1);
 
 void BM_AttitudePipeline_Run(benchmark::State& state) {
   auto imu = make_imu();
-  posefuse::AttitudePipeline att = posefuse::make_attitude_pipeline();
+  // eq 3-4 as printed (kSeed), as the corridor program runs it; the default is the Euler kinematics.
+  posefuse::AttitudePipeline att =
+      posefuse::make_attitude_pipeline(posefuse::AttitudeConfig{0.98, posefuse::GyroToTiltRate::kSeed});
   std::size_t k = 0;
   std::int64_t t_ns = 0;
   for (auto _ : state) {
@@ -168,7 +171,7 @@ BENCHMARK(BM_AttitudePipeline_Run);
 void BM_AttitudeStages_ByHand(benchmark::State& state) {
   auto imu = make_imu();
   posefuse::AccelerometerTiltStage s1;
-  posefuse::ComplementaryTiltStage s2(0.98);
+  posefuse::ComplementaryTiltStage s2(0.98, posefuse::GyroToTiltRate::kSeed);
   posefuse::CompassStage s3;
   std::size_t k = 0;
   std::int64_t t_ns = 0;

@@ -173,7 +173,7 @@ TEST_CASE("Corridor sim: an invalid config is rejected, naming the field", "[sim
     CHECK_THROWS_AS(simulate_corridor(c, 1), posefuse::invalid_argument);
     CHECK_THROWS_WITH(simulate_corridor(c, 1), Catch::Contains(std::string("CorridorSimConfig: ") + k.what));
   }
-  CHECK_NOTHROW(posefuse::validate(CorridorSimConfig{}));
+  CHECK_NOTHROW(posefuse::sim::validate(CorridorSimConfig{}));
   CorridorSimConfig edge;
   edge.jitter_s = 0.0049;  // just under half of the IMU's 10 ms
   const auto s = simulate_corridor(edge, 1);
