@@ -76,68 +76,35 @@
 ///     \Delta v(b) = \Delta v + J_{v b_a}\delta b_a + J_{v b_g}\delta b_g, \quad
 ///     \Delta p(b) = \Delta p + J_{p b_a}\delta b_a + J_{p b_g}\delta b_g. \f]
 ///
-/// **Samples.** Stamps are integer nanoseconds (core/time.hpp). A sample that
-/// is older than the last one (kOutOfOrder), has the same stamp (kRepeated),
-/// comes after a gap above `max_gap_ns` (kGap) or is not finite (kNonFinite)
-/// is reported and not integrated; the state is then untouched.
+/// **Samples** (core/samples.hpp) have integer-nanosecond stamps; a sample
+/// that cannot be integrated is reported (ImuStatus, inertial/imu_types.hpp)
+/// and leaves the state untouched.
 ///
 /// **Allocation.** Everything is fixed-size. The samples are kept for
 /// re-integration in a std::vector reserved at construction
 /// (`PreintegrationOptions::reserve_samples`); adding a sample allocates only
 /// when that reserve is exceeded.
+///
+/// The value types (ImuNoise, ImuBias, ImuStatus, ImuDelta) are in
+/// inertial/imu_types.hpp; `preintegrate` over a recorded sample range is in
+/// inertial/preintegrate.hpp, included at the end of this header.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <span>
-#include <string>
 #include <vector>
 
 #include <posefuse/core/error.hpp>
 #include <posefuse/core/samples.hpp>
 #include <posefuse/core/time.hpp>
+#include <posefuse/inertial/detail/small_rotation.hpp>
+#include <posefuse/inertial/imu_types.hpp>
 #include <posefuse/lie/so3.hpp>
 
 namespace posefuse {
-
-/// Continuous-time IMU noise figures (the four numbers of a Kalibr / EuRoC
-/// `imu.yaml`).
-struct ImuNoise {
-  double gyro_noise_density = 1.6968e-4;   ///< \f$ \sigma_g \f$ (rad/s/√Hz)
-  double accel_noise_density = 2.0e-3;     ///< \f$ \sigma_a \f$ (m/s²/√Hz)
-  double gyro_random_walk = 1.9393e-5;     ///< \f$ \sigma_{b_g} \f$ (rad/s²/√Hz)
-  double accel_random_walk = 3.0e-3;       ///< \f$ \sigma_{b_a} \f$ (m/s³/√Hz)
-
-  /// Checks every figure is finite and non-negative.
-  /// @throws posefuse::invalid_argument naming the first bad figure
-  void validate() const {
-    const double v[4] = {gyro_noise_density, accel_noise_density, gyro_random_walk,
-                         accel_random_walk};
-    const char* names[4] = {"gyro_noise_density", "accel_noise_density", "gyro_random_walk",
-                            "accel_random_walk"};
-    for (int i = 0; i < 4; ++i)
-      if (!(std::isfinite(v[i]) && v[i] >= 0.0))
-        throw invalid_argument(std::string("ImuNoise: ") + names[i] +
-                               " must be finite and >= 0, got " + std::to_string(v[i]));
-  }
-};
-
-/// Accelerometer and gyroscope biases in the body frame.
-struct ImuBias {
-  Eigen::Vector3d accel = Eigen::Vector3d::Zero();  ///< \f$ b_a \f$ (m/s²)
-  Eigen::Vector3d gyro = Eigen::Vector3d::Zero();   ///< \f$ b_g \f$ (rad/s)
-  /// As one vector \f$ [b_a, b_g] \f$.
-  [[nodiscard]] Eigen::Matrix<double, 6, 1> vector() const {
-    Eigen::Matrix<double, 6, 1> b;
-    b << accel, gyro;
-    return b;
-  }
-  /// From one vector \f$ [b_a, b_g] \f$.
-  [[nodiscard]] static ImuBias from_vector(const Eigen::Matrix<double, 6, 1>& b) {
-    return ImuBias{b.head<3>(), b.tail<3>()};
-  }
-};
 
 /// Configuration of a Preintegration.
 struct PreintegrationOptions {
@@ -150,115 +117,6 @@ struct PreintegrationOptions {
   /// Samples reserved for re-integration (no allocation per sample below this).
   std::size_t reserve_samples = 1024;
 };
-
-/// Outcome of adding one IMU sample.
-enum class ImuStatus {
-  kApplied,        ///< integrated
-  kStarted,        ///< the first sample: it starts the interval, nothing to integrate yet
-  kOutOfOrder,     ///< stamp before the last sample's: not integrated
-  kRepeated,       ///< stamp equal to the last sample's: not integrated
-  kGap,            ///< time since the last sample above max_gap_ns: not integrated
-  kNonFinite,      ///< a reading is NaN or infinite: not integrated
-  kOutOfRange,     ///< (preintegrate) the samples do not cover the requested interval
-};
-
-/// Human-readable name of an ImuStatus.
-[[nodiscard]] constexpr const char* to_string(ImuStatus s) noexcept {
-  switch (s) {
-    case ImuStatus::kApplied: return "applied";
-    case ImuStatus::kStarted: return "started";
-    case ImuStatus::kOutOfOrder: return "out of order";
-    case ImuStatus::kRepeated: return "repeated stamp";
-    case ImuStatus::kGap: return "gap above the limit";
-    case ImuStatus::kNonFinite: return "non-finite reading";
-    case ImuStatus::kOutOfRange: return "samples do not cover the interval";
-  }
-  return "unknown";
-}
-
-/// The pre-integrated measurement \f$ (\Delta p, \Delta R, \Delta v) \f$, a
-/// posefuse::Manifold of dimension 9 with tangent \f$ [\delta p, \delta\phi, \delta v] \f$
-/// (\f$ \Delta R \oplus \delta\phi = \Delta R\,\mathrm{Exp}(\delta\phi) \f$; p and v Euclidean).
-struct ImuDelta {
-  using Scalar = double;             ///< scalar type
-  static constexpr int Dim = 9;      ///< tangent dimension
-  using Tangent = Eigen::Matrix<double, 9, 1>;  ///< [δp, δφ, δv]
-  Eigen::Vector3d p = Eigen::Vector3d::Zero();  ///< \f$ \Delta p_{ij} \f$ (m, frame i)
-  SO3d R;                                       ///< \f$ \Delta R_{ij} = R_i^\top R_j \f$
-  Eigen::Vector3d v = Eigen::Vector3d::Zero();  ///< \f$ \Delta v_{ij} \f$ (m/s, frame i)
-
-  /// \f$ x \oplus d \f$.
-  [[nodiscard]] ImuDelta plus(const Tangent& d) const {
-    return ImuDelta{p + d.segment<3>(0), R.plus(d.segment<3>(3)), v + d.segment<3>(6)};
-  }
-  /// \f$ y \ominus x \f$ (this = y).
-  [[nodiscard]] Tangent minus(const ImuDelta& x) const {
-    Tangent d;
-    d << p - x.p, R.minus(x.R), v - x.v;
-    return d;
-  }
-};
-
-namespace detail {
-
-/// \f$ \mathrm{Exp}(\theta) \f$ as a quaternion and \f$ J_r(\theta) = I - a[\theta]_\times + b[\theta]_\times^2 \f$
-/// with its coefficients \f$ a = (1 - \cos\theta)/\theta^2 \f$, \f$ b = (\theta - \sin\theta)/\theta^3 \f$,
-/// by their Taylor series (to \f$ |\theta|^8 \f$, exact in double) for the small
-/// angles of one IMU step, |θ| < 0.05 rad, and by SO3 otherwise. No
-/// trigonometric call on the hot path.
-template <class Lazy = void>
-void small_exp(const Eigen::Vector3d& theta, Eigen::Quaterniond& q, Eigen::Matrix3d& Jr, double& a,
-               double& b) {
-  const double t2 = theta.squaredNorm();
-  if (t2 < 0.05 * 0.05) {
-    const double x2 = t2 / 4.0;  // (θ/2)²
-    const double c = 1.0 - x2 * (1.0 / 2.0) * (1.0 - x2 * (1.0 / 12.0) * (1.0 - x2 * (1.0 / 30.0) * (1.0 - x2 * (1.0 / 56.0))));
-    const double k = 0.5 * (1.0 - x2 * (1.0 / 6.0) * (1.0 - x2 * (1.0 / 20.0) * (1.0 - x2 * (1.0 / 42.0) * (1.0 - x2 * (1.0 / 72.0)))));
-    q = Eigen::Quaterniond(c, k * theta.x(), k * theta.y(), k * theta.z());
-    a = 0.5 * (1.0 - t2 * (1.0 / 12.0) * (1.0 - t2 * (1.0 / 30.0) * (1.0 - t2 * (1.0 / 56.0) * (1.0 - t2 * (1.0 / 90.0)))));
-    b = (1.0 / 6.0) * (1.0 - t2 * (1.0 / 20.0) * (1.0 - t2 * (1.0 / 42.0) * (1.0 - t2 * (1.0 / 72.0) * (1.0 - t2 * (1.0 / 110.0)))));
-  } else {
-    q = SO3d::exp(theta).quaternion();
-    const double th = std::sqrt(t2);
-    a = detail::one_minus_cos_over_x2(th);
-    b = detail::x_minus_sin_over_x3(th);
-  }
-  // J_r = I - a W + b W², W² = θθ^T - |θ|² I.
-  Jr.noalias() = (b * theta) * theta.transpose();
-  Jr.diagonal().array() += 1.0 - b * t2;
-  Jr(0, 1) += a * theta.z();
-  Jr(1, 0) -= a * theta.z();
-  Jr(0, 2) -= a * theta.y();
-  Jr(2, 0) += a * theta.y();
-  Jr(1, 2) += a * theta.x();
-  Jr(2, 1) -= a * theta.x();
-}
-
-/// \f$ -[u]_\times M \f$: the columns \f$ m_j \times u \f$ (27 flops instead of 45).
-template <class Lazy = void>
-Eigen::Matrix3d neg_skew_times(const Eigen::Vector3d& u, const Eigen::Matrix3d& M) noexcept {
-  Eigen::Matrix3d out;
-  for (int j = 0; j < 3; ++j) {
-    out(0, j) = M(1, j) * u.z() - M(2, j) * u.y();
-    out(1, j) = M(2, j) * u.x() - M(0, j) * u.z();
-    out(2, j) = M(0, j) * u.y() - M(1, j) * u.x();
-  }
-  return out;
-}
-
-/// \f$ M [u]_\times = M (-[u]_\times)^\top \f$ for an N x 3 matrix M, column by
-/// column (\f$ 6N \f$ flops; the columns vectorise when N is even).
-template <int N>
-Eigen::Matrix<double, N, 3> times_skew(const Eigen::Matrix<double, N, 3>& M,
-                                       const Eigen::Vector3d& u) noexcept {
-  Eigen::Matrix<double, N, 3> out;
-  out.col(0) = M.col(1) * u.z() - M.col(2) * u.y();
-  out.col(1) = M.col(2) * u.x() - M.col(0) * u.z();
-  out.col(2) = M.col(0) * u.y() - M.col(1) * u.x();
-  return out;
-}
-
-}  // namespace detail
 
 /// IMU pre-integration between two keyframes (see the file comment).
 ///
@@ -599,59 +457,9 @@ class Preintegration {
   double dt_s_ = 0.0;
 };
 
-/// The sample at `t_ns` linearly interpolated between `a` and `b` (readings
-/// only; the magnetometer is interpolated too).
-/// @pre a.t_ns < b.t_ns and a.t_ns <= t_ns <= b.t_ns
-[[nodiscard]] inline ImuSample interpolate_imu(const ImuSample& a, const ImuSample& b,
-                                               std::int64_t t_ns) noexcept {
-  const double s = seconds_between(t_ns, a.t_ns) / seconds_between(b.t_ns, a.t_ns);
-  ImuSample out;
-  out.t_ns = t_ns;
-  out.accel_mps2 = a.accel_mps2 + s * (b.accel_mps2 - a.accel_mps2);
-  out.gyro_radps = a.gyro_radps + s * (b.gyro_radps - a.gyro_radps);
-  out.mag_uT = a.mag_uT + s * (b.mag_uT - a.mag_uT);
-  return out;
-}
-
-/// Pre-integrates a time-ordered sample stream between two arbitrary stamps:
-/// the boundary samples at `t0_ns` and `t1_ns` are linearly interpolated
-/// from the samples around them (used as they are when a stamp matches).
-/// @param[in] samples time-ordered samples covering [t0_ns, t1_ns]
-/// @param[in] t0_ns, t1_ns the keyframe stamps, t0_ns < t1_ns
-/// @param[out] out a fresh Preintegration (its noise, bias and options are kept)
-/// @return kApplied, kOutOfRange when the samples do not cover the interval
-///         (or t1_ns <= t0_ns), or the first non-applied status of a sample
-///         inside it (out is then partial: do not use it)
-template <class Lazy = void>
-[[nodiscard]] ImuStatus preintegrate(std::span<const ImuSample> samples, std::int64_t t0_ns,
-                                     std::int64_t t1_ns, Preintegration& out) {
-  out = Preintegration(out.noise(), out.bias(), out.options());
-  if (!(t0_ns < t1_ns) || samples.empty() || samples.front().t_ns > t0_ns ||
-      samples.back().t_ns < t1_ns)
-    return ImuStatus::kOutOfRange;
-  // First sample with t > t0 (binary search; the stream must be ordered, which add() checks).
-  std::size_t lo = 0, hi = samples.size();
-  while (lo < hi) {
-    const std::size_t mid = lo + (hi - lo) / 2;
-    if (samples[mid].t_ns <= t0_ns) lo = mid + 1; else hi = mid;
-  }
-  const std::size_t k0 = lo;  // samples[k0 - 1].t_ns <= t0 < samples[k0].t_ns
-  const ImuSample& before = samples[k0 - 1];
-  const ImuSample first =
-      before.t_ns == t0_ns ? before : interpolate_imu(before, samples[k0], t0_ns);
-  ImuStatus st = out.add(first);
-  if (st != ImuStatus::kStarted) return st;
-  for (std::size_t k = k0; k < samples.size(); ++k) {
-    const ImuSample& s = samples[k];
-    if (s.t_ns >= t1_ns) {
-      const ImuSample last = s.t_ns == t1_ns ? s : interpolate_imu(samples[k - 1], s, t1_ns);
-      st = out.add(last);
-      return st;
-    }
-    st = out.add(s);
-    if (st != ImuStatus::kApplied) return st;
-  }
-  return ImuStatus::kOutOfRange;  // unreachable: samples.back().t_ns >= t1_ns
-}
-
 }  // namespace posefuse
+
+// The free functions over recorded sample ranges (preintegrate,
+// interpolate_imu) need the class above; they are included here so that
+// this header alone keeps offering them.
+#include <posefuse/inertial/preintegrate.hpp>
