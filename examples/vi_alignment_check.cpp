@@ -127,7 +127,7 @@ posefuse::SE3d euroc_cam0_extrinsic() {
 
 struct WindowResult {
   double t_s;
-  posefuse::AlignmentStatus status;
+  posefuse::VisualInertialAlignmentStatus status;
   double scale_pct = 0, gravity_deg = 0, velocity_rms = 0, gyro_bias = 0;
 };
 
@@ -194,7 +194,7 @@ Report run_check(const Options& o) {
     wr.t_s = posefuse::seconds_between(gt.t_ns[kf[w0]], gt.t_ns.front());
     wr.status = res.status;
     ++r.statuses[posefuse::to_string(res.status)];
-    if (res.status == posefuse::AlignmentStatus::kOk) {
+    if (res.status == posefuse::VisualInertialAlignmentStatus::kOk) {
       const double s_true = 1.0 / o.sfm_scale;
       const posefuse::SO3d R_c0_w = T_c0_w.so3();
       wr.scale_pct = 100.0 * std::abs(res.scale - s_true) / s_true;
@@ -242,7 +242,7 @@ Summary summarise(const Report& r) {
   Summary s;
   std::vector<double> sc, gr, ve, gy;
   for (const WindowResult& w : r.windows) {
-    if (w.status != posefuse::AlignmentStatus::kOk) continue;
+    if (w.status != posefuse::VisualInertialAlignmentStatus::kOk) continue;
     ++s.ok;
     sc.push_back(w.scale_pct);
     gr.push_back(w.gravity_deg);
@@ -260,7 +260,7 @@ Summary summarise(const Report& r) {
 std::string plot_svg(const Report& r) {
   std::vector<apps::svg::Point> sc, gr;
   for (const WindowResult& w : r.windows) {
-    if (w.status != posefuse::AlignmentStatus::kOk) continue;
+    if (w.status != posefuse::VisualInertialAlignmentStatus::kOk) continue;
     sc.push_back({w.t_s, w.scale_pct});
     gr.push_back({w.t_s, w.gravity_deg});
   }

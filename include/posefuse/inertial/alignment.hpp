@@ -71,7 +71,7 @@
 namespace posefuse {
 
 /// Outcome of a visual-inertial alignment.
-enum class AlignmentStatus {
+enum class VisualInertialAlignmentStatus {
   kOk,                       ///< every output is valid
   kInsufficientExcitation,   ///< accelerations too uniform for the scale (file comment)
   kSolveFailed,              ///< rank-deficient system or non-finite result
@@ -79,20 +79,20 @@ enum class AlignmentStatus {
   kGravityNorm,              ///< |g| far from the configured norm
 };
 
-/// Human-readable name of an AlignmentStatus.
-[[nodiscard]] constexpr const char* to_string(AlignmentStatus s) noexcept {
+/// Human-readable name of a VisualInertialAlignmentStatus.
+[[nodiscard]] constexpr const char* to_string(VisualInertialAlignmentStatus s) noexcept {
   switch (s) {
-    case AlignmentStatus::kOk: return "ok";
-    case AlignmentStatus::kInsufficientExcitation: return "insufficient excitation";
-    case AlignmentStatus::kSolveFailed: return "solve failed";
-    case AlignmentStatus::kNonPositiveScale: return "non-positive scale";
-    case AlignmentStatus::kGravityNorm: return "gravity norm off";
+    case VisualInertialAlignmentStatus::kOk: return "ok";
+    case VisualInertialAlignmentStatus::kInsufficientExcitation: return "insufficient excitation";
+    case VisualInertialAlignmentStatus::kSolveFailed: return "solve failed";
+    case VisualInertialAlignmentStatus::kNonPositiveScale: return "non-positive scale";
+    case VisualInertialAlignmentStatus::kGravityNorm: return "gravity norm off";
   }
   return "unknown";
 }
 
 /// Configuration of align_visual_inertial.
-struct AlignmentOptions {
+struct VisualInertialAlignmentOptions {
   double gravity_norm = 9.81;           ///< G (m/s²)
   double min_accel_std = 0.25;          ///< excitation threshold (m/s²)
   double max_gravity_norm_error = 1.0;  ///< allowed ||g| - G| before refinement (m/s²)
@@ -100,10 +100,13 @@ struct AlignmentOptions {
 };
 
 /// The result of aligning N keyframes (valid only when status is kOk;
-/// diagnostics are filled as far as the computation went).
+/// diagnostics are filled as far as the computation went). Not to be
+/// confused with posefuse::AlignmentResult (eval/alignment.hpp), the
+/// similarity that aligns an estimated trajectory to a reference.
 template <int N>
-struct AlignmentResult {
-  AlignmentStatus status = AlignmentStatus::kSolveFailed;  ///< outcome
+struct VisualInertialAlignment {
+  /// outcome
+  VisualInertialAlignmentStatus status = VisualInertialAlignmentStatus::kSolveFailed;
   double scale = 0;                    ///< s: metric = s × SfM units
   Eigen::Vector3d gravity_c0 = Eigen::Vector3d::Zero();  ///< g in c0, refined (m/s²)
   double gravity_norm_unrefined = 0;   ///< |g| of step 2 (m/s²)
@@ -123,15 +126,14 @@ struct AlignmentResult {
 /// @param[in] options gravity norm, thresholds
 /// @throws posefuse::invalid_argument when a pre-integration has no step
 template <int N>
-[[nodiscard]] AlignmentResult<N> align_visual_inertial(const std::array<SE3d, N>& T_c0_c,
-                                                       const SE3d& T_b_c,
-                                                       std::span<Preintegration, N - 1> pre,
-                                                       const AlignmentOptions& options = {}) {
+[[nodiscard]] VisualInertialAlignment<N> align_visual_inertial(
+    const std::array<SE3d, N>& T_c0_c, const SE3d& T_b_c, std::span<Preintegration, N - 1> pre,
+    const VisualInertialAlignmentOptions& options = {}) {
   static_assert(N >= 3, "align_visual_inertial needs at least 3 keyframes");
   using M3 = Eigen::Matrix3d;
   constexpr int U = 3 * N + 4;        // unknowns [v_0..v_{N-1}, g, s]
   constexpr int Rows = 6 * (N - 1);
-  AlignmentResult<N> out;
+  VisualInertialAlignment<N> out;
   for (const Preintegration& p : pre)
     if (!(p.dt_s() > 0)) throw invalid_argument("align_visual_inertial: a pre-integration has no step");
   const SO3d R_bc = T_b_c.so3();
@@ -166,7 +168,7 @@ template <int N>
     for (const Eigen::Vector3d& x : a) var += (x - mean).squaredNorm();
     out.accel_std = std::sqrt(var / double(N - 1));
     if (!(out.accel_std >= options.min_accel_std)) {
-      out.status = AlignmentStatus::kInsufficientExcitation;
+      out.status = VisualInertialAlignmentStatus::kInsufficientExcitation;
       return out;
     }
   }
@@ -207,11 +209,11 @@ template <int N>
   out.gravity_norm_unrefined = g.norm();
   out.scale = s0;
   if (!(s0 > 0)) {
-    out.status = AlignmentStatus::kNonPositiveScale;
+    out.status = VisualInertialAlignmentStatus::kNonPositiveScale;
     return out;
   }
   if (!(std::abs(g.norm() - options.gravity_norm) <= options.max_gravity_norm_error)) {
-    out.status = AlignmentStatus::kGravityNorm;
+    out.status = VisualInertialAlignmentStatus::kGravityNorm;
     return out;
   }
 
@@ -239,7 +241,7 @@ template <int N>
   out.scale = s;
   out.gravity_c0 = options.gravity_norm * g_hat;
   if (!(s > 0)) {
-    out.status = AlignmentStatus::kNonPositiveScale;
+    out.status = VisualInertialAlignmentStatus::kNonPositiveScale;
     return out;
   }
   for (int k = 0; k < N; ++k) out.velocity_c0[k] = x2.template segment<3>(3 * k);
@@ -257,7 +259,7 @@ template <int N>
     out.T_w_b[k] = SE3d(out.R_w_c0.act(pk - p0), out.R_w_c0.compose(R[k]));
     out.velocity_w[k] = out.R_w_c0.act(out.velocity_c0[k]);
   }
-  out.status = AlignmentStatus::kOk;
+  out.status = VisualInertialAlignmentStatus::kOk;
   return out;
 }
 
