@@ -5,7 +5,22 @@
 //
 //   BM_PoseGraph4Dof/posefuse/N  build the graph + PoseGraph4Dof::optimize()
 //                                (LM from the odometry start, function
-//                                tolerance 1e-10)
+//                                tolerance 1e-10), with one PoseGraphWorkspace
+//                                held across the iterations, as a program
+//                                solving graph after graph would hold it
+//   BM_PoseGraph4Dof/posefuse_own_workspace/N  the same with each graph's own
+//                                workspace: its buffers are fresh memory on
+//                                every iteration (the cost of a one-off
+//                                solve). Run it alone to see that cost: glibc
+//                                returns the freed buffers to the kernel and
+//                                every iteration pages them in again (2-core
+//                                Debian 12 VM, Release, CPU time, median of 5,
+//                                each row alone: 5.5-5.9 ms against 2.9 ms
+//                                at 1 000 nodes, --benchmark_filter=
+//                                'posefuse_own_workspace/1000$' and 'posefuse/1000$').
+//                                After other rows in the same process, glibc's
+//                                adaptive heap thresholds keep freed memory
+//                                and the two rows take the same time.
 //   BM_PoseGraph4Dof/ceres/N     build a ceres::Problem + Solve (only when
 //                                Ceres is found): the same residual with
 //                                automatic differentiation, one [x y z yaw]
@@ -15,7 +30,8 @@
 //   BM_G2o/posefuse/G            the real planar g2o file G (manhattan, mit) end
 //                                to end from its parsed contents: build the
 //                                graph, rotation-first start, optimize() (the
-//                                planar 3x3-block path)
+//                                planar 3x3-block path; one workspace held
+//                                across the iterations, as above)
 //   BM_G2o/posefuse_4dof/G       the same on the general 4x4-block path
 //                                (planar_fast_path = false), for comparison
 //   BM_G2o/ceres_file/G          Ceres from the file's poses, as Ceres's own
@@ -29,9 +45,9 @@
 //                                posefuse's rotation-first poses (computed
 //                                once, outside the timing)
 //
-// The files are found as $POSEFUSE_DATA_DIR/posegraph, else
-// ../shared/data/posegraph from the working directory, else the build's
-// POSEFUSE_DATA_DIR; without them those rows stop with "SKIPPED: ...".
+// The files are found as $POSEFUSE_DATA_DIR/posegraph, else in the data
+// folder configured at build time (the CMake cache variable
+// POSEFUSE_DATA_DIR); without them those rows stop with "SKIPPED: ...".
 // File parsing is outside the timing of every row; the first vertex is
 // held fixed in both solvers (the files have no FIX line).
 //
@@ -78,20 +94,27 @@ const sim::PoseGraphProblem& problem(int n) {
   return it->second;
 }
 
-void BM_PoseGraph4Dof_posefuse(benchmark::State& state) {
+void run_posefuse(benchmark::State& state, bool held_workspace) {
   const sim::PoseGraphProblem& pr = problem(static_cast<int>(state.range(0)));
+  PoseGraphWorkspace workspace;
   PoseGraphSummary s;
   for (auto _ : state) {
     PoseGraph4Dof g = sim::to_pose_graph(pr);
-    s = g.optimize();
+    s = held_workspace ? g.optimize({}, workspace) : g.optimize();
     benchmark::DoNotOptimize(s);
   }
   state.counters["chi2"] = s.final_cost;
   state.counters["iterations"] = s.iterations;
 }
+void BM_PoseGraph4Dof_posefuse(benchmark::State& state) { run_posefuse(state, true); }
+void BM_PoseGraph4Dof_posefuse_own_workspace(benchmark::State& state) { run_posefuse(state, false); }
 BENCHMARK(BM_PoseGraph4Dof_posefuse)
     ->Name("BM_PoseGraph4Dof/posefuse")
     ->Arg(1000)->Arg(10000)->Arg(100000)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PoseGraph4Dof_posefuse_own_workspace)
+    ->Name("BM_PoseGraph4Dof/posefuse_own_workspace")
+    ->Arg(1000)->Arg(10000)
     ->Unit(benchmark::kMillisecond);
 
 /// The real g2o files (see the file comment), parsed once; nullopt when absent.
@@ -101,7 +124,6 @@ const std::optional<G2oGraph2d>& real_graph(const std::string& file) {
   if (it != cache.end()) return it->second;
   std::vector<std::filesystem::path> dirs;
   if (const char* d = std::getenv("POSEFUSE_DATA_DIR"); d != nullptr && *d != '\0') dirs.emplace_back(d);
-  dirs.emplace_back("../shared/data");
 #ifdef POSEFUSE_DEFAULT_DATA_DIR
   dirs.emplace_back(POSEFUSE_DEFAULT_DATA_DIR);
 #endif
@@ -132,11 +154,12 @@ void run_g2o_posefuse(benchmark::State& state, bool planar) {
   if (skip_without(state, g, which)) return;
   PoseGraphOptions o;
   o.planar_fast_path = planar;
+  PoseGraphWorkspace workspace;
   PoseGraphSummary s;
   for (auto _ : state) {
     PoseGraph4Dof graph = pose_graph_from_g2o(*g);
-    graph.initialize_rotation_first();
-    s = graph.optimize(o);
+    graph.initialize_rotation_first(workspace);
+    s = graph.optimize(o, workspace);
     benchmark::DoNotOptimize(s);
   }
   state.counters["chi2"] = s.final_cost;
