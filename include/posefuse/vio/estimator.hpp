@@ -99,6 +99,9 @@ class VioEstimator {
   /// Starts from an explicit state at the first frame (instead of the static start).
   void set_initial_state(const ImuState& x) { initial_ = x; }
 
+  /// Makes the camera-IMU extrinsic a variable of the solve (from the next window on).
+  void set_estimate_extrinsic(bool on) { w_.estimate_extrinsic = on; }
+
   /// Adds one IMU sample (time-ordered; frames need the samples up to their stamp).
   void add_imu(const ImuSample& s) { imu_.push_back(s); }
 
