@@ -86,7 +86,7 @@ posefuse::Trajectory random_trajectory(std::size_t n, unsigned seed) {
 TEST_CASE("Formats: KITTI writer and reader round-trip bit-exactly", "[io][kitti]") {
   TempDir dir("kitti-rt");
   posefuse::Trajectory traj = random_trajectory(200, 7);
-  traj.poses[3].translation() = Eigen::Vector3d(5e-324, -0.0, 1e308);  // extremes survive too
+  traj.poses[3].translation() = Eigen::Vector3d(5e-324, -0.0, 1e100);  // extremes survive (1e100 m: the largest accepted)
   posefuse::write_kitti(dir.path() / "poses.txt", traj);
   posefuse::write_kitti_times(dir.path() / "times.txt", traj);
   const posefuse::Trajectory back =
@@ -311,9 +311,12 @@ TEST_CASE("Formats: KITTI times.txt errors name the right file and line", "[io][
   const auto poses = dir.write("poses.txt", kIdentityRow + kIdentityRow + kIdentityRow);
   SECTION("not increasing") {
     const auto times = dir.write("times.txt", "0.0\n0.1\n0.1\n");
+    // The library names no program flag: only the programs that have one add it.
     check_error(expect_io_error([&] { (void)posefuse::read_kitti(poses, times); }), times, 3,
-                "timestamp 0.1 repeats the previous one (0.1 on line 2); repeated stamps can be "
-                "kept first or last instead (--duplicates)");
+                "timestamp 0.1 repeats the previous one (0.1 on line 2)");
+    CHECK_THROWS_AS(posefuse::read_kitti(poses, times), posefuse::repeated_stamp_error);
+    CHECK(std::string(expect_io_error([&] { (void)posefuse::read_kitti(poses, times); }).what())
+              .find("--duplicates") == std::string::npos);
   }
   SECTION("decreasing, also via read_kitti_times") {
     const auto times = dir.write("times.txt", "0.0\n0.2\n0.1\n");
@@ -621,4 +624,18 @@ TEST_CASE("Formats: EuRoC ground truth through read_trajectory, with the duplica
   CHECK_THROWS_AS(posefuse::read_trajectory(file, posefuse::Format::kEuroc, file), posefuse::invalid_argument);
   CHECK_THROWS_AS(posefuse::write_trajectory(dir.path() / "o.csv", t, posefuse::Format::kEuroc),
                   posefuse::invalid_argument);
+}
+
+TEST_CASE("Formats: positions beyond 1e100 m are refused at their line", "[io][errors]") {
+  TempDir dir("huge-position");
+  const auto tum = dir.write("huge.tum", "0 0 0 0 0 0 0 1\n0.1 1e200 0 0 0 0 0 1\n");
+  check_error(expect_io_error([&] { (void)posefuse::read_tum(tum); }), tum, 2,
+              "position coordinate of magnitude 1e+200 m is beyond 1e+100 m");
+  const auto kitti = dir.write("huge.txt", kIdentityRow + "1 0 0 0 0 1 0 -1e101 0 0 1 0\n");
+  check_error(expect_io_error([&] { (void)posefuse::read_kitti(kitti); }), kitti, 2, "1e+101 m is beyond");
+  const auto euroc = dir.write("huge.csv", "#t,p,q\n1000,0,0,0,1,0,0,0\n2000,0,0,1e150,1,0,0,0\n");
+  check_error(expect_io_error([&] { (void)posefuse::read_euroc_groundtruth(euroc); }), euroc, 3, "1e+150 m");
+  // 1e100 itself is accepted.
+  const auto edge = dir.write("edge.tum", "0 1e100 0 0 0 0 0 1\n");
+  CHECK(posefuse::read_tum(edge).poses[0].translation().x() == 1e100);
 }

@@ -215,6 +215,7 @@ template <class Lazy = void>
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
     T.linear() = q.toRotationMatrix();
     T.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
+    detail::traj_io::check_position(T.translation(), file, n);
     const detail::traj_io::StampAction action =
         gt.t_ns.empty() ? detail::traj_io::StampAction::kAppend
                         : detail::traj_io::next_stamp_action(t_ns, gt.t_ns.back(), previous_line,

@@ -50,6 +50,7 @@ NumberedRows<Eigen::Isometry3d> read_kitti_rows(const std::filesystem::path& fil
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
     T.linear() = checked_rotation(R, options.rotation_tolerance, file, reader.line_no());
     T.translation() = Eigen::Vector3d(v[3], v[7], v[11]);
+    check_position(T.translation(), file, reader.line_no());
     rows.values.push_back(T);
     rows.lines.push_back(reader.line_no());
   }

@@ -61,8 +61,18 @@ struct ReadOptions {
   /// Equal consecutive stamps (TUM files, KITTI `times.txt`). The library's
   /// default refuses them so that nothing is dropped silently; programs
   /// that accept them (`evaluate_trajectory --duplicates first`) report
-  /// what was dropped through ReadReport.
+  /// what was dropped through ReadReport. A refused repeat is thrown as
+  /// repeated_stamp_error.
   DuplicateStamps duplicates = DuplicateStamps::kError;
+};
+
+/// A repeated stamp refused under DuplicateStamps::kError: an io_error
+/// (file:line) of its own type, so that a program that offers another
+/// policy can say so (`evaluate_trajectory --duplicates`) while the others
+/// print the reader's message alone.
+class repeated_stamp_error : public io_error {
+ public:
+  using io_error::io_error;
 };
 
 /// What a reader dropped under `ReadOptions::duplicates`.

@@ -72,6 +72,7 @@ TumWithCovariance read_tum_rows(const std::filesystem::path& file, const ReadOpt
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
     T.linear() = q.toRotationMatrix();
     T.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
+    check_position(T.translation(), file, n);
     Eigen::Matrix<double, 6, 6> C = Eigen::Matrix<double, 6, 6>::Zero();
     if (columns > 8) {
       const int dim = columns == 14 ? 3 : 6;

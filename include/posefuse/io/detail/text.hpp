@@ -12,6 +12,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstddef>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -132,6 +133,24 @@ template <class Lazy = void>
   return std::string(buf, ptr);
 }
 
+/// Largest accepted magnitude (m) of a position coordinate in a trajectory
+/// file. Squared differences of larger coordinates overflow a double, so no
+/// error statistic could be computed from them; 1e100 m is far beyond any
+/// physical trajectory (the observable universe is about 1e27 m across).
+inline constexpr double kMaxAbsPosition = 1e100;
+
+/// Refuses a position coordinate beyond kMaxAbsPosition (file:line).
+template <class Lazy = void>
+void check_position(const Eigen::Vector3d& p, const std::filesystem::path& file, std::size_t line) {
+  if (p.cwiseAbs().maxCoeff() > kMaxAbsPosition) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%g", p.cwiseAbs().maxCoeff());
+    throw io_error(file, line,
+                   std::string("position coordinate of magnitude ") + buf +
+                       " m is beyond 1e+100 m, where squared errors overflow");
+  }
+}
+
 /// What a reader does with the row it just parsed (see `next_stamp_action`).
 enum class StampAction {
   kAppend,       ///< a new, later stamp: append the row
@@ -151,17 +170,19 @@ template <class Stamp>
 }
 
 /// The error for a stamp `t` that does not follow `previous` (read on
-/// `previous_line`) strictly. `offer_policies`: say that repeats can be
-/// kept first or last instead (for readers that take ReadOptions::duplicates).
+/// `previous_line`) strictly. `offer_policies`: the reader takes
+/// ReadOptions::duplicates, and a repeat is thrown as repeated_stamp_error
+/// (a program that offers another policy adds its flag to the message);
+/// otherwise, and for a decreasing stamp, as io_error. The message names no
+/// program flag.
 template <class Stamp>
 [[noreturn]] void throw_stamp_out_of_order(Stamp t, Stamp previous, std::size_t previous_line,
                                            const std::filesystem::path& file, std::size_t line,
                                            bool offer_policies) {
-  std::string message = "timestamp " + stamp_text(t) +
-                        (t == previous ? " repeats the previous one" : " is earlier than the previous one") +
-                        " (" + stamp_text(previous) + " on line " + std::to_string(previous_line) + ")";
-  if (t == previous && offer_policies)
-    message += "; repeated stamps can be kept first or last instead (--duplicates)";
+  const std::string message = "timestamp " + stamp_text(t) +
+                              (t == previous ? " repeats the previous one" : " is earlier than the previous one") +
+                              " (" + stamp_text(previous) + " on line " + std::to_string(previous_line) + ")";
+  if (t == previous && offer_policies) throw repeated_stamp_error(file, line, message);
   throw io_error(file, line, message);
 }
 
@@ -170,8 +191,8 @@ template <class Stamp>
 /// The one rule of every reader that takes ReadOptions::duplicates; `Stamp`
 /// is double (seconds) or an integer type (nanoseconds).
 /// @throws posefuse::io_error (file:line) for a decreasing stamp, and for a
-///         repeated one under DuplicateStamps::kError (the message names
-///         the `--duplicates` choices a program offers)
+///         repeated one under DuplicateStamps::kError (then of type
+///         repeated_stamp_error)
 template <class Stamp>
 [[nodiscard]] StampAction next_stamp_action(Stamp t, Stamp previous, std::size_t previous_line,
                                             DuplicateStamps policy, ReadReport* report,
