@@ -50,15 +50,31 @@ struct Row {
 
 /// One saved result; a missing member or a wrong type names the file.
 Row read_result(const std::filesystem::path& file, std::string name) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw apps::data_error(file.string() + ": cannot open file for reading");
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw apps::data_error(file.string() + ": read error");
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec))
+    throw apps::data_error(file.string() + ": cannot open file for reading: it is a folder");
+  std::string text;
+  try {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw apps::data_error(file.string() + ": cannot open file for reading");
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    if (in.bad()) throw apps::data_error(file.string() + ": read error");
+  } catch (const apps::data_error&) {
+    throw;
+  } catch (const std::exception&) {  // the library's stream errors name no file
+    throw apps::data_error(file.string() + ": read error");
+  }
   try {
     const apps::JsonValue j = apps::JsonValue::parse(text);
+    // evaluate_trajectory saves only finite statistics (it refuses a
+    // non-finite result), so a null or negative one is not its file.
     const auto number = [&](const char* key) {
-      // Non-finite statistics are saved as null.
-      return j[key].is_null() ? std::nan("") : j[key].number();
+      if (j[key].is_null())
+        throw apps::data_error(file.string() + ": \"" + key + "\" is null; a saved result has finite statistics");
+      const double v = j[key].number();
+      if (!(v >= 0.0))
+        throw apps::data_error(file.string() + ": \"" + key + "\" is negative (" + apps::shortest(v) + ")");
+      return v;
     };
     Row r;
     r.name = std::move(name);
@@ -67,6 +83,9 @@ Row read_result(const std::filesystem::path& file, std::string name) {
     r.alignment = j["alignment"].string();
     r.unit = j["unit"].string();
     r.count = number("count");
+    if (r.count < 1.0 || r.count != std::floor(r.count) || r.count > 9007199254740992.0)
+      throw apps::data_error(file.string() + ": \"count\" must be a whole number of pairs >= 1, got " +
+                             apps::shortest(r.count));
     r.rmse = number("rmse");
     r.mean = number("mean");
     r.median = number("median");
@@ -75,6 +94,8 @@ Row read_result(const std::filesystem::path& file, std::string name) {
     r.max = number("max");
     if (j.has("nees_mean")) r.nees_mean = number("nees_mean");
     return r;
+  } catch (const apps::data_error&) {
+    throw;
   } catch (const std::runtime_error& e) {
     throw apps::data_error(file.string() + ": not a saved result (" + e.what() + ")");
   }

@@ -22,6 +22,7 @@
 #include <random>
 #include <vector>
 
+#include <apps/cli.hpp>
 #include <posefuse/core/angles.hpp>
 #include <posefuse/core/pipeline.hpp>
 #include <posefuse/eval/metrics.hpp>
@@ -114,15 +115,20 @@ struct Position {
 };
 }  // namespace rover
 
-int main() {
+namespace {
+int tutorial(const posefuse::apps::CommandLine& cmd) {
   using namespace rover;
+  posefuse::apps::Parser cli("ekf_custom_model", "",
+                             "The tutorial of docs/writing-models.md: a rover's own motion model and\n"
+                             "range-bearing sensor in posefuse's EKF. It takes no flags.");
+  if (!cli.parse(cmd)) return 0;  // --help was printed
   // Check the user's Jacobians against central differences first.
   const Pose x0{1.0, 2.0, 3.1};
   const auto rc = posefuse::testing::check_motion_model(Rover{}, x0, Vec2(1.5, 0.3), 0.1, 1e-6);
   const auto sc = posefuse::testing::check_measurement_model(BeaconSensor{Vec2(4, -3)}, x0, 1e-6);
   std::printf("conformance: Rover %s, BeaconSensor %s\n", rc ? "ok" : rc.message.c_str(),
               sc ? "ok" : sc.message.c_str());
-  if (!rc || !sc) return 1;
+  if (!rc || !sc) throw posefuse::apps::data_error("a model fails its Jacobian check");
 
   auto pipeline = Localiser{} | Position{};  // operator| needs no using-declaration
   pipeline.stage<0>().ekf.reset(Pose{8, 0, std::numbers::pi / 2}, Mat3::Identity() * 0.01);
@@ -159,3 +165,6 @@ int main() {
               posefuse::rmse_2d(truth_xy, dead_xy), posefuse::rmse_2d(truth_xy, ekf_xy));
   return 0;
 }
+}  // namespace
+
+int main(int argc, char** argv) { return posefuse::apps::run_main(argc, argv, tutorial); }

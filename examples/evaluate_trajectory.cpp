@@ -51,6 +51,7 @@
 #include <apps/cli.hpp>
 #include <apps/json.hpp>
 #include <apps/output_file.hpp>
+#include <apps/spooled_input.hpp>
 #include <apps/svg.hpp>
 #include <posefuse/eval/consistency.hpp>
 #include <posefuse/eval/metrics.hpp>
@@ -212,6 +213,14 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   if (!ref || !est) throw apps::usage_error("--groundtruth and --estimate are required");
   o.groundtruth = *ref;
   o.estimate = *est;
+  {
+    std::vector<std::pair<std::string, std::filesystem::path>> outputs, inputs{{"--groundtruth", o.groundtruth},
+                                                                             {"--estimate", o.estimate}};
+    if (o.times) inputs.emplace_back("--times", *o.times);
+    if (o.save_results) outputs.emplace_back("--save-results", *o.save_results);
+    if (o.plot) outputs.emplace_back("--plot", *o.plot);
+    apps::refuse_output_over_input(outputs, inputs);
+  }
   o.ref_format_given = ref_format ? ref_format : format;
   o.est_format_given = est_format ? est_format : format;
   o.rpe.all_pairs = all_pairs;
@@ -249,13 +258,10 @@ struct Loaded {
   std::vector<Eigen::Matrix<double, 6, 6>> covariance;
 };
 
-Loaded load(const std::filesystem::path& file, posefuse::Format format,
-            const std::optional<std::filesystem::path>& times, posefuse::DuplicateStamps duplicates,
-            bool allow_covariance, std::vector<std::string>& warnings) {
-  posefuse::ReadOptions options;
-  options.duplicates = duplicates;
-  posefuse::ReadReport report;
-  Loaded out;
+/// Reads one trajectory file (and, for KITTI, its times) into `out`.
+void read_into(Loaded& out, const std::filesystem::path& file, posefuse::Format format,
+               const std::optional<std::filesystem::path>& times, const posefuse::ReadOptions& options,
+               posefuse::ReadReport& report, bool allow_covariance) {
   if (format == posefuse::Format::kKitti) {
     out.trajectory = posefuse::read_kitti(file, times, options, &report);
   } else if (format == posefuse::Format::kEuroc) {
@@ -267,6 +273,20 @@ Loaded load(const std::filesystem::path& file, posefuse::Format format,
     out.covariance = std::move(t.covariance);
   } else {
     out.trajectory = posefuse::read_tum(file, options, &report);
+  }
+}
+
+Loaded load(const std::filesystem::path& file, posefuse::Format format,
+            const std::optional<std::filesystem::path>& times, posefuse::DuplicateStamps duplicates,
+            bool allow_covariance, std::vector<std::string>& warnings) {
+  posefuse::ReadOptions options;
+  options.duplicates = duplicates;
+  posefuse::ReadReport report;
+  Loaded out;
+  try {
+    read_into(out, file, format, times, options, report, allow_covariance);
+  } catch (const posefuse::repeated_stamp_error& e) {  // this program offers the other policies
+    throw apps::data_error(std::string(e.what()) + "; repeated stamps can be kept first or last instead (--duplicates)");
   }
   if (report.duplicates_dropped > 0) {
     const std::filesystem::path& where = format == posefuse::Format::kKitti ? *times : file;
@@ -546,9 +566,10 @@ posefuse::Trajectory thin(const posefuse::Trajectory& traj, const Options& o) {
 
 /// Fills in the formats not given on the command line from the files'
 /// content, then checks what depends on them (usage errors, exit 2).
-Options resolve_formats(Options o) {
-  o.ref_format = o.ref_format_given ? *o.ref_format_given : posefuse::detect_format(o.groundtruth);
-  o.est_format = o.est_format_given ? *o.est_format_given : posefuse::detect_format(o.estimate);
+/// `ref_path`, `est_path`: where the files are read from (see run).
+Options resolve_formats(Options o, const std::filesystem::path& ref_path, const std::filesystem::path& est_path) {
+  o.ref_format = o.ref_format_given ? *o.ref_format_given : posefuse::detect_format(ref_path);
+  o.est_format = o.est_format_given ? *o.est_format_given : posefuse::detect_format(est_path);
   const bool any_kitti =
       o.ref_format == posefuse::Format::kKitti || o.est_format == posefuse::Format::kKitti;
   if (o.times && !any_kitti) throw apps::usage_error("--times only applies to KITTI files");
@@ -567,13 +588,19 @@ Options resolve_formats(Options o) {
   return o;
 }
 
-int run(const Options& given) {
-  const Options o = resolve_formats(given);
+int run_read(const Options& given, apps::SpooledInputs& spool) {
+  // A file whose format is detected is read twice (detection, then the
+  // reader): a pipe or <(command) is then copied once (apps/spooled_input.hpp).
+  const std::filesystem::path ref_path =
+      given.ref_format_given ? given.groundtruth : spool.readable(given.groundtruth);
+  const std::filesystem::path est_path = given.est_format_given ? given.estimate : spool.readable(given.estimate);
+  const Options o = resolve_formats(given, ref_path, est_path);
   std::vector<std::string> warnings;
   const posefuse::Trajectory ref_file =
-      load(o.groundtruth, o.ref_format, o.times, o.duplicates, false, warnings).trajectory;
-  const Loaded est_loaded = load(o.estimate, o.est_format, o.times, o.duplicates, true, warnings);
+      load(ref_path, o.ref_format, o.times, o.duplicates, false, warnings).trajectory;
+  const Loaded est_loaded = load(est_path, o.est_format, o.times, o.duplicates, true, warnings);
   const posefuse::Trajectory& est_file = est_loaded.trajectory;
+  for (std::string& w : warnings) w = spool.shown(w);
   for (const std::string& w : warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   posefuse::Trajectory ref = thin(ref_file, o);
   const posefuse::Trajectory est = thin(est_file, o);
@@ -605,8 +632,23 @@ int run(const Options& given) {
     throw apps::data_error("--n-to-align " + std::to_string(o.align.n_to_align) + " but only " +
                            std::to_string(ref_sync.size()) + " poses are associated");
   }
-  posefuse::MetricResult result = o.metric_rpe ? posefuse::rpe(ref_sync, est_sync, o.rpe)
-                                               : posefuse::ape(ref_sync, est_sync, o.relation, o.align);
+  posefuse::MetricResult result;
+  try {
+    result = o.metric_rpe ? posefuse::rpe(ref_sync, est_sync, o.rpe)
+                          : posefuse::ape(ref_sync, est_sync, o.relation, o.align);
+  } catch (const posefuse::invalid_argument& e) {
+    // The library's reason names its function; say what it means for the files.
+    const std::string what = e.what();
+    const std::string files = o.groundtruth.string() + " and " + o.estimate.string();
+    if (what.find("degenerate") != std::string::npos || what.find("no horizontal spread") != std::string::npos)
+      throw apps::data_error(files + ": the " + std::to_string(ref_sync.size()) +
+                             " associated positions are all at one point or on one line, so --align " +
+                             std::string(posefuse::to_string(o.align.alignment)) +
+                             " has no unique answer (use --align none)");
+    if (what.find("not finite") != std::string::npos)
+      throw apps::data_error(files + ": an error is not finite (positions too large to be compared)");
+    throw apps::data_error(files + ": " + what.substr(what.find(':') == std::string::npos ? 0 : what.find(':') + 2));
+  }
   if (o.align.project_to_plane && est_loaded.covariance_dim > 0 && !o.metric_rpe)
     throw apps::usage_error("NEES (an estimate with covariance) cannot be combined with --project-to-plane");
   const std::optional<posefuse::NeesResult> nees =
@@ -621,6 +663,20 @@ int run(const Options& given) {
     print_table(o, result, nees, ref_file.size(), est_file.size());
   }
   return 0;
+}
+
+/// run_read with the messages naming the files as given.
+int run(const Options& given) {
+  apps::SpooledInputs spool;
+  try {
+    return run_read(given, spool);
+  } catch (const apps::usage_error&) {
+    throw;
+  } catch (const std::exception& e) {
+    const std::string what = e.what(), shown = spool.shown(what);
+    if (shown == what) throw;
+    throw apps::data_error(shown);
+  }
 }
 
 }  // namespace

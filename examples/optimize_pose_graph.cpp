@@ -106,6 +106,15 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
                "2 bad usage.");
   if (!cli.parse(cmd)) return std::nullopt;
   if (o.groundtruth && !o.input) throw apps::usage_error("--groundtruth needs --input");
+  if (cli.given("--robust-scale") && o.loss.type == RobustLoss::kNone)
+    throw apps::usage_error("--robust-scale needs a robust loss (--robust huber|cauchy)");
+  {
+    std::vector<std::pair<std::string, std::filesystem::path>> outputs, inputs;
+    if (o.input) inputs.emplace_back("--input", *o.input);
+    if (o.groundtruth) inputs.emplace_back("--groundtruth", *o.groundtruth);
+    if (o.out) outputs.emplace_back("--out", *o.out);
+    apps::refuse_output_over_input(outputs, inputs);
+  }
   return o;
 }
 
@@ -172,12 +181,36 @@ double aligned_rmse(const PoseGraph4Dof& graph, const std::vector<SE2<double>>& 
   return std::sqrt(s / double(est.size()));
 }
 
+/// Values the solver's normal equations can hold: coordinates (m) up to
+/// 1e50 and information entries up to 1e100, so that information times
+/// squared lever arms stays far below the largest double. Larger values are
+/// refused naming the line (a standard deviation below 1e-50 or a pose
+/// 1e50 m away is no measurement).
+void check_magnitudes(const G2oGraph2d& g, const std::filesystem::path& file) {
+  constexpr double kMaxCoordinate = 1e50, kMaxInformation = 1e100;
+  const auto refuse = [&](std::size_t line, const char* what, double v, double limit) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "%s %g is beyond %g, which the solver cannot hold", what, v, limit);
+    throw io_error(file, line, buf);
+  };
+  for (const G2oVertexSE2& v : g.vertices)
+    for (const double c : {v.x, v.y})
+      if (std::abs(c) > kMaxCoordinate) refuse(v.line, "a coordinate of", c, kMaxCoordinate);
+  for (const G2oEdgeSE2& e : g.edges) {
+    for (const double c : {e.dx, e.dy})
+      if (std::abs(c) > kMaxCoordinate) refuse(e.line, "a translation of", c, kMaxCoordinate);
+    const double info = e.information.cwiseAbs().maxCoeff();
+    if (info > kMaxInformation) refuse(e.line, "an information entry of", info, kMaxInformation);
+  }
+}
+
 int run(const Options& o) {
   G2oGraph2d file_graph;
   PoseGraph4Dof graph;
   std::string name = "built-in";
   if (o.input) {
     file_graph = read_g2o_2d(*o.input);
+    check_magnitudes(file_graph, *o.input);
     name = o.input->filename().string();
     try {
       graph = pose_graph_from_g2o(file_graph, o.loss);
@@ -192,7 +225,7 @@ int run(const Options& o) {
     graph = sim::to_pose_graph(sim::make_pose_graph_problem(c));
     for (std::size_t k = 0; k < graph.num_nodes(); ++k) {
       const Pose4Dof& x = graph.poses()[k];
-      file_graph.vertices.push_back({graph.ids()[k], x.p.x(), x.p.y(), x.yaw});
+      file_graph.vertices.push_back({graph.ids()[k], x.p.x(), x.p.y(), x.yaw, 0});
     }
   }
   const std::optional<std::vector<SE2<double>>> truth =

@@ -147,6 +147,16 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
     throw apps::usage_error("give --groundtruth and at least one --estimate, or neither (synthetic data)");
   if (o.times && o.format == Format::kTum)
     throw apps::usage_error("--times only applies to KITTI files");
+  if (cli.given("--method") && !o.out) throw apps::usage_error("--method chooses what --out writes; give --out");
+  {
+    std::vector<std::pair<std::string, std::filesystem::path>> outputs, inputs;
+    if (o.groundtruth) inputs.emplace_back("--groundtruth", *o.groundtruth);
+    if (o.times) inputs.emplace_back("--times", *o.times);
+    for (const auto& e : o.estimates) inputs.emplace_back("--estimate", e);
+    if (o.out && o.estimates.size() <= 1) outputs.emplace_back("--out", *o.out);
+    if (o.plot) outputs.emplace_back("--plot", *o.plot);
+    apps::refuse_output_over_input(outputs, inputs);
+  }
   if (o.out && o.estimates.size() > 1) {
     std::set<std::string> names;
     for (const auto& e : o.estimates)

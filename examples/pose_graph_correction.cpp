@@ -119,6 +119,17 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   if (o.odometry && !o.loops && !o.oracle) throw apps::usage_error("give --loops FILE or --oracle-loops");
   if (!o.odometry && (o.loops || o.oracle)) throw apps::usage_error("--loops and --oracle-loops need --odometry");
   if (o.up.empty()) o.up = o.format == Format::kKitti ? "-y" : "z";
+  if (cli.given("--robust-scale") && o.loss.type == RobustLoss::kNone)
+    throw apps::usage_error("--robust-scale needs a robust loss (--robust huber|cauchy)");
+  {
+    std::vector<std::pair<std::string, std::filesystem::path>> outputs, inputs;
+    if (o.odometry) inputs.emplace_back("--odometry", *o.odometry);
+    if (o.groundtruth) inputs.emplace_back("--groundtruth", *o.groundtruth);
+    if (o.loops) inputs.emplace_back("--loops", *o.loops);
+    if (o.out) outputs.emplace_back("--out", *o.out);
+    if (o.svg) outputs.emplace_back("--svg", *o.svg);
+    apps::refuse_output_over_input(outputs, inputs);
+  }
   return o;
 }
 
@@ -206,6 +217,32 @@ std::vector<Edge4Dof> outlier_loops(const Trajectory& truth, int n, std::uint32_
   return out;
 }
 
+/// A loop edge of the --loops file must join two frames of the odometry and
+/// have a finite cost at the odometry's poses (else the solve overflows);
+/// the loops file and its line are named, never an internal edge number.
+void check_loop(const LoopEdge4DofRecord& r, const std::filesystem::path& file, const Trajectory& odo_up) {
+  const auto n = static_cast<std::int64_t>(odo_up.size());
+  for (const std::int64_t id : {r.from, r.to})
+    if (id < 0 || id >= n)
+      throw io_error(file, r.line,
+                     "node " + std::to_string(id) + " is not a frame of the odometry (frames 0 to " +
+                         std::to_string(n - 1) + ")");
+  const Edge4Dof at = sim::relative_edge(to_pose(odo_up.poses[std::size_t(r.from)]),
+                                         to_pose(odo_up.poses[std::size_t(r.to)]), r.from, r.to);
+  Eigen::Vector4d e;
+  e << at.dp - r.dp, at.dyaw - r.dyaw;
+  const double cost = e.dot(r.information * e);
+  if (!std::isfinite(cost)) {
+    char buf[256];
+    std::snprintf(buf, sizeof buf,
+                  "the edge's cost at the odometry poses is not finite (largest translation component %g m, "
+                  "yaw %g rad): "
+                  "values too large for the solver",
+                  r.dp.cwiseAbs().maxCoeff(), r.dyaw);
+    throw io_error(file, r.line, buf);
+  }
+}
+
 struct Ape {
   double se3 = 0, posyaw = 0;
 };
@@ -279,6 +316,7 @@ int run(const Options& o) {
     if (o.oracle) loops = oracle_loops(truth_up, loop_info);
     if (o.loops) {
       for (const LoopEdge4DofRecord& r : read_loop_edges_4dof(*o.loops)) {
+        check_loop(r, *o.loops, odo_up);
         Edge4Dof e;
         e.from = r.from;
         e.to = r.to;
@@ -317,7 +355,9 @@ int run(const Options& o) {
   const Ape before = ape_of(truth_up, odo_up);
   const Ape after = ape_of(truth_up, after_up);
   for (const double v : {before.se3, before.posyaw, after.se3, after.posyaw, s.final_cost})
-    if (!std::isfinite(v)) throw apps::data_error(name + ": a result is not finite");
+    if (!std::isfinite(v))
+      throw apps::data_error(o.loops ? o.loops->string() + ": the solve gave a non-finite result; the loop edges' values are too large"
+                                     : name + ": a result is not finite");
 
   apps::OutputFiles files;
   if (o.out) {

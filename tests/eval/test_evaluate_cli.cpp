@@ -271,6 +271,8 @@ TEST_CASE("Evaluate CLI: repeated stamps, byte-order marks and stamp units", "[e
   CHECK(refused.status == 1);
   CHECK(refused.err.find("dup.tum:12: timestamp") != std::string::npos);
   CHECK(refused.err.find("repeats the previous one") != std::string::npos);
+  CHECK(refused.err.find("(--duplicates)") != std::string::npos);  // this program has the flag
+  CHECK(count_lines(refused.err) == 1);
 
   // A byte-order mark in front of the first stamp.
   std::ofstream(dir.path() / "bom.tum") << "\xEF\xBB\xBF" << text;

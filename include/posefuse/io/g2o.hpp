@@ -51,6 +51,7 @@ struct G2oVertexSE2 {
   double x = 0.0;       ///< m
   double y = 0.0;       ///< m
   double theta = 0.0;   ///< rad
+  std::size_t line = 0;  ///< 1-based line it was read from (0: not read from a file)
 };
 
 /// A g2o `EDGE_SE2`: the pose of node `to` in the frame of node `from`.
@@ -61,6 +62,7 @@ struct G2oEdgeSE2 {
   double dy = 0.0;        ///< m, in i's frame
   double dtheta = 0.0;    ///< rad
   Eigen::Matrix3d information = Eigen::Matrix3d::Identity();  ///< order x, y, theta
+  std::size_t line = 0;  ///< 1-based line it was read from (0: not read from a file)
 };
 
 /// The content of a g2o 2-D file.
@@ -77,6 +79,7 @@ struct LoopEdge4DofRecord {
   Eigen::Vector3d dp = Eigen::Vector3d::Zero();  ///< j's position in i's frame (m)
   double dyaw = 0.0;                             ///< relative yaw (rad)
   Eigen::Matrix4d information = Eigen::Matrix4d::Identity();  ///< order x, y, z, yaw
+  std::size_t line = 0;  ///< 1-based line it was read from (0: not read from a file)
 };
 
 namespace detail::g2o_io {
@@ -173,7 +176,7 @@ template <class Lazy = void>
         throw io_error(file, n,
                        "duplicate vertex id " + std::to_string(id) + " (first defined on line " +
                            std::to_string(it->second) + ")");
-      g.vertices.push_back({id, v[0], v[1], v[2]});
+      g.vertices.push_back({id, v[0], v[1], v[2], n});
     } else if (tag == "EDGE_SE2") {
       expect(12, "i j dx dy dtheta I11 I12 I13 I22 I23 I33");
       const std::vector<double> v = io::numbers(tok, 3, 9, file, n);
@@ -189,6 +192,7 @@ template <class Lazy = void>
       e.dtheta = v[2];
       e.information = io::from_upper<3>(v.data() + 3);
       io::check_information(e.information, file, n);
+      e.line = n;
       g.edges.push_back(e);
     } else if (tag == "FIX") {
       if (tok.size() < 2) throw io_error(file, n, "FIX expects at least one node id");
@@ -263,6 +267,7 @@ template <class Lazy = void>
     e.dyaw = v[3];
     e.information = io::from_upper<4>(v.data() + 4);
     io::check_information(e.information, file, n);
+    e.line = n;
     edges.push_back(e);
   }
   return edges;

@@ -1,0 +1,219 @@
+// The programs' contract (docs/programs.md), probed as a new user would: one
+// row per bad or unusual input, each with the exit status it must give and
+// what its one line on stderr must (and must not) say. A program that is not
+// built is skipped visibly.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <sstream>
+#include <string>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <vector>
+
+#include "support/run_program.hpp"
+#include "support/temp_dir.hpp"
+
+namespace fs = std::filesystem;
+using posefuse::test::count_lines;
+using posefuse::test::Run;
+using posefuse::test::TempDir;
+
+namespace {
+
+std::string quoted(const fs::path& p) { return "'" + p.string() + "'"; }
+
+/// A TUM trajectory of n poses on a planar loop (x, y vary), 0.1 s apart.
+std::string tum_loop(int n, double scale = 1.0) {
+  std::ostringstream s;
+  s.precision(17);
+  for (int k = 0; k < n; ++k) {
+    const double a = 0.05 * k;
+    s << 0.1 * k << ' ' << scale * 10 * std::cos(a) << ' ' << scale * 10 * std::sin(a) << ' ' << 0.01 * k
+      << " 0 0 0 1\n";
+  }
+  return s.str();
+}
+
+/// One probe: a program, its arguments (with {dir} for the scratch folder),
+/// the exit status, text the stderr line must contain and text it must not.
+struct Probe {
+  std::string program, args;
+  int status;
+  std::vector<std::string> contains, absent;
+};
+
+std::string expand(std::string args, const TempDir& dir) {
+  const std::string key = "{dir}";
+  for (std::size_t at = args.find(key); at != std::string::npos; at = args.find(key))
+    args.replace(at, key.size(), dir.path().string());
+  return args;
+}
+
+void check(const Probe& p, const TempDir& dir) {
+  const fs::path exe = posefuse::test::example(p.program);
+  if (exe.empty()) {
+    WARN("SKIPPED: example '" << p.program << "' not built");
+    return;
+  }
+  const Run r = posefuse::test::run(exe, expand(p.args, dir), dir);
+  INFO(p.program << " " << p.args << "\nstderr: " << r.err);
+  CHECK(r.status == p.status);
+  if (p.status != 0) {
+    CHECK(count_lines(r.err) == 1);
+    CHECK(r.err.rfind(p.program + ": ", 0) == 0);
+    CHECK((p.status == 2) == (r.err.find("(try --help)") != std::string::npos));
+  }
+  for (const std::string& c : p.contains) CHECK(r.err.find(expand(c, dir)) != std::string::npos);
+  for (const std::string& a : p.absent) CHECK(r.err.find(a) == std::string::npos);
+}
+
+}  // namespace
+
+TEST_CASE("Programs keep the exit-status and one-line contract on bad input", "[examples][contract]") {
+  const TempDir dir("contract");
+  (void)dir.write("gt.tum", tum_loop(200));
+  (void)dir.write("est.tum", tum_loop(200));
+  // A huge but finite position on line 3.
+  std::string huge = tum_loop(200);
+  {
+    std::size_t at = 0;
+    for (int k = 0; k < 2; ++k) at = huge.find('\n', at) + 1;
+    huge.replace(at, huge.find('\n', at) - at, "0.2 1e200 0 0 0 0 0 1");
+  }
+  (void)dir.write("huge.tum", huge);
+  // A ground truth that never moves: no rigid alignment is defined.
+  std::string still;
+  for (int k = 0; k < 50; ++k) still += std::to_string(0.1 * k) + " 1 2 3 0 0 0 1\n";
+  (void)dir.write("still.tum", still);
+  // Repeated stamps on line 3.
+  (void)dir.write("dup.tum", "0 0 0 0 0 0 0 1\n0.1 1 0 0 0 0 0 1\n0.1 2 0 0 0 0 0 1\n0.2 3 0 0 0 0 0 1\n");
+  // Loop edges: to a frame that does not exist (line 2), and a huge translation (line 1).
+  const std::string info = " 100 0 0 0 100 0 0 100 0 400\n";
+  (void)dir.write("loops_missing.txt", "# i j x y z yaw I\n10 5000 0 0 0 0" + info);
+  (void)dir.write("loops_huge.txt", "10 150 1e308 0 0 0" + info);
+  (void)dir.write("loops_ok.txt", "10 150 0 0 0 0" + info);
+  // Saved results that evaluate_trajectory never writes.
+  const std::string result_head =
+      R"({"metric": "ape", "pose_relation": "trans_part", "alignment": "se3", "unit": "m", )";
+  const std::string stats = R"("mean": 1, "median": 1, "std": 0, "min": 1, "max": 1})";
+  (void)dir.write("null_rmse.json", result_head + R"("count": 5, "rmse": null, )" + stats);
+  (void)dir.write("negative_count.json", result_head + R"("count": -5, "rmse": 1, )" + stats);
+  (void)dir.write("fraction_count.json", result_head + R"("count": 2.5, "rmse": 1, )" + stats);
+  fs::create_directory(dir.path() / "folder");
+  // g2o edges on line 3 whose values the solver cannot hold.
+  const std::string vertices = "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\n";
+  (void)dir.write("huge.g2o", vertices + "EDGE_SE2 0 1 1e308 0 0 1 0 0 1 0 1\n");
+  (void)dir.write("strong.g2o", vertices + "EDGE_SE2 0 1 1 0 0 1e300 0 0 1e300 0 1e300\n");
+
+  const std::string eval = "--groundtruth '{dir}/gt.tum' --estimate ";
+  const std::vector<Probe> probes = {
+      // 11. the tutorial parses its (empty) command line
+      {"ekf_custom_model", "--bogus", 2, {"unknown option '--bogus'"}, {}},
+      {"ekf_custom_model", "extra", 2, {"unexpected argument"}, {}},
+      // 5. the loops file and its line are at fault, not the odometry
+      {"pose_graph_correction",
+       "--format tum --odometry '{dir}/est.tum' --groundtruth '{dir}/gt.tum' --loops '{dir}/loops_missing.txt'",
+       1,
+       {"{dir}/loops_missing.txt:2: node 5000 is not a frame of the odometry"},
+       {"est.tum", "edge 0", "pose graph:"}},
+      {"pose_graph_correction",
+       "--format tum --odometry '{dir}/est.tum' --groundtruth '{dir}/gt.tum' --loops '{dir}/loops_huge.txt'",
+       1,
+       {"{dir}/loops_huge.txt:1: ", "1e+308"},
+       {"est.tum", "a result is not finite"}},
+      {"pose_graph_correction",
+       "--format tum --odometry '{dir}/est.tum' --groundtruth '{dir}/gt.tum' --loops '{dir}/loops_ok.txt' --json",
+       0,
+       {},
+       {}},
+      // 6. huge finite values and degenerate ground truth name the file
+      {"evaluate_trajectory", eval + "'{dir}/huge.tum'", 1, {"{dir}/huge.tum:3: ", "1e+200"},
+       {"compute_statistics", "error 2"}},
+      {"evaluate_trajectory", "--groundtruth '{dir}/still.tum' --estimate '{dir}/still.tum' --align se3", 1,
+       {"{dir}/still.tum", "--align none"},
+       {"umeyama"}},
+      {"optimize_pose_graph", "--input '{dir}/huge.g2o'", 1, {"{dir}/huge.g2o:3: ", "1e+308"}, {"singular"}},
+      {"optimize_pose_graph", "--input '{dir}/strong.g2o'", 1, {"{dir}/strong.g2o:3: ", "1e+300"},
+       {"singular", "too weak"}},
+      // 7. a folder given as a result
+      {"compare_results", "--result '{dir}/folder'", 1, {"{dir}/folder: ", "folder"}, {"basic_filebuf"}},
+      // 8. programs without --duplicates do not offer it
+      {"pose_graph_correction",
+       "--format tum --odometry '{dir}/dup.tum' --groundtruth '{dir}/dup.tum' --oracle-loops", 1,
+       {"{dir}/dup.tum:3: timestamp 0.1 repeats the previous one"},
+       {"--duplicates"}},
+      {"orb_trajectory_correction", "--format tum --groundtruth '{dir}/dup.tum' --estimate '{dir}/dup.tum'", 1,
+       {"{dir}/dup.tum:3: timestamp 0.1 repeats the previous one"},
+       {"--duplicates"}},
+      {"evaluate_trajectory", eval + "'{dir}/dup.tum' --duplicates error", 1,
+       {"{dir}/dup.tum:3: ", "(--duplicates)"},
+       {}},
+      // 10. saved results that cannot be right
+      {"compare_results", "--result '{dir}/null_rmse.json'", 1, {"{dir}/null_rmse.json: ", "rmse"}, {"nan"}},
+      {"compare_results", "--result '{dir}/negative_count.json'", 1, {"{dir}/negative_count.json: ", "count"}, {}},
+      {"compare_results", "--result '{dir}/fraction_count.json'", 1, {"{dir}/fraction_count.json: ", "2.5"}, {}},
+      // Smaller: an output over an input, flags that do nothing alone
+      {"evaluate_trajectory", eval + "'{dir}/est.tum' --save-results '{dir}/gt.tum'", 2,
+       {"--save-results {dir}/gt.tum is the input of --groundtruth"},
+       {}},
+      {"pose_graph_correction",
+       "--format tum --odometry '{dir}/est.tum' --groundtruth '{dir}/gt.tum' --oracle-loops --out '{dir}/./est.tum'", 2,
+       {"is the input of --odometry"},
+       {}},
+      {"optimize_pose_graph", "--robust-scale 2", 2, {"--robust-scale needs a robust loss"}, {}},
+      {"pose_graph_correction", "--robust none --robust-scale 2", 2, {"--robust-scale needs a robust loss"}, {}},
+      {"orb_trajectory_correction", "--method cv", 2, {"give --out"}, {}},
+  };
+  for (const Probe& p : probes) check(p, dir);
+  // The refused runs left the inputs as they were.
+  CHECK(posefuse::test::slurp(dir.path() / "gt.tum") == tum_loop(200));
+  CHECK(posefuse::test::slurp(dir.path() / "est.tum") == tum_loop(200));
+}
+
+TEST_CASE("ekf_custom_model: --help prints usage only, unwritable output fails",
+          "[examples][contract][tutorial]") {
+  POSEFUSE_REQUIRE_EXAMPLE(exe, "ekf_custom_model");
+  const TempDir dir("contract-tutorial");
+  const Run help = posefuse::test::run(exe, "--help", dir);
+  CHECK(help.status == 0);
+  CHECK(help.out.rfind("usage: ekf_custom_model", 0) == 0);
+  CHECK(help.out.find("position RMSE") == std::string::npos);  // the demo did not run
+  if (fs::exists("/dev/full")) {
+    const std::string cmd = "'" + exe.string() + "' > /dev/full 2> '" + (dir.path() / "err.txt").string() + "'";
+    const int raw = std::system(cmd.c_str());
+    CHECK(WIFEXITED(raw));
+    CHECK(WEXITSTATUS(raw) == 1);
+    CHECK(posefuse::test::slurp(dir.path() / "err.txt") ==
+          "ekf_custom_model: cannot write to standard output\n");
+  }
+}
+
+TEST_CASE("evaluate_trajectory reads a named pipe once when it detects the format",
+          "[examples][contract][eval]") {
+  POSEFUSE_REQUIRE_EXAMPLE(exe, "evaluate_trajectory");
+  const TempDir dir("contract-fifo");
+  const fs::path gt = dir.write("gt.tum", tum_loop(100));
+  const fs::path fifo = dir.path() / "est.fifo";
+  REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+  // The writer blocks until the program opens the pipe; `timeout` ends a
+  // program that would open it a second time and wait forever.
+  const std::string writer = "cat '" + gt.string() + "' > '" + fifo.string() + "' &";
+  REQUIRE(std::system(writer.c_str()) == 0);
+  const Run r = posefuse::test::run("/usr/bin/timeout",
+                                    "20 '" + exe.string() + "' --groundtruth '" + gt.string() +
+                                        "' --estimate '" + fifo.string() + "' --json",
+                                    dir);
+  // Unblocks the writer if the program never opened the pipe.
+  const int fd = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK);
+  if (fd >= 0) ::close(fd);
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  CHECK(posefuse::test::Json::parse(r.out)["rmse"].number() == 0.0);
+  CHECK(r.err.empty());
+}
