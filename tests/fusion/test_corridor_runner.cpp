@@ -47,8 +47,8 @@ bool has_warning(const posefuse::CorridorRunResult& r, const std::string& part) 
 
 TEST_CASE("Corridor: SLAM alone fails at corner 3; the gated fuser completes the loop",
           "[fusion][corridor]") {
-  // Seeds 1-10: the range README states. The seed fuser's 180-degree flip
-  // (raw angle averaging near +-180 deg) is counted too (README says how often).
+  // Seeds 1-10: the range docs/reproductions.md states. The seed fuser's 180-degree flip
+  // (raw angle averaging near +-180 deg) is counted too (docs/reproductions.md says how often).
   int seed_fuser_flips = 0, gated_rmse_better = 0;
   double gated_lo = 1e9, gated_hi = 0, odom_lo = 1e9, odom_hi = 0;
   for (std::uint64_t seed = 1; seed <= 10; ++seed) {
@@ -92,7 +92,7 @@ TEST_CASE("Corridor: SLAM alone fails at corner 3; the gated fuser completes the
     odom_lo = std::min(odom_lo, m[kOdom].loop_closure_error_m);
     odom_hi = std::max(odom_hi, m[kOdom].loop_closure_error_m);
   }
-  // README: "0.09-0.98 m ... against 0.23-2.28 m for odometry alone".
+  // docs/reproductions.md: "0.09-0.98 m ... against 0.23-2.28 m for odometry alone".
   CHECK(std::round(gated_lo * 100) == 9);
   CHECK(std::round(gated_hi * 100) == 98);
   CHECK(std::round(odom_lo * 100) == 23);

@@ -158,7 +158,7 @@ TEST_CASE("g2o: MIT Killian Court converges from the rotation-first start", "[gr
   const PoseGraphSummary s = graph.optimize();
   INFO("chi2 " << s.final_cost << " after " << s.iterations << " iterations, " << to_string(s.termination));
   CHECK(s.termination == Termination::kFunctionTolerance);
-  CHECK(s.final_cost < 41.2);  // README: 41.163 (from the file's poses LM stalls above 2000)
+  CHECK(s.final_cost < 41.2);  // docs/pose-graph.md: 41.163 (from the file's poses LM stalls above 2000)
   CHECK(s.planar);
 }
 

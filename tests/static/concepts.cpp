@@ -125,7 +125,7 @@ static_assert(std::is_same_v<Seed000::Covariance, Eigen::Matrix2d>);
 
 // Every model, Lie type, fuser and pipeline of the library satisfies its
 // concept (checked here rather than in the headers, so that including a
-// header does not instantiate the float variants: compile cost, README).
+// header does not instantiate the float variants: compile cost, docs/design.md).
 // posefuse/fusion/gated_fuser.hpp
 static_assert(Stage<GatedFuser<double>>);
 static_assert(Stage<GatedFuser<float>>);
