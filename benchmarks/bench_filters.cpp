@@ -72,7 +72,7 @@ using Eigen::VectorXd;
 // Inputs
 
 /// Frame intervals of KITTI 06: $POSEFUSE_DATA_DIR/kitti/06/times.txt, else
-/// ../shared/data/kitti/06/times.txt (relative to the working directory).
+/// the configured data folder's kitti/06/times.txt (POSEFUSE_DATA_DIR at build time).
 /// When neither exists, a generated equivalent: 1100 intervals uniform in
 /// [0.10324, 0.10466] s (the real file's range; its mean is 0.10390 s, its
 /// standard deviation 0.15 ms). Cycled to kFrames.
@@ -85,7 +85,9 @@ const Intervals& kitti_intervals() {
     Intervals iv;
     std::vector<std::string> paths;
     if (const char* d = std::getenv("POSEFUSE_DATA_DIR")) paths.push_back(std::string(d) + "/kitti/06/times.txt");
-    paths.emplace_back("../shared/data/kitti/06/times.txt");
+#ifdef POSEFUSE_DEFAULT_DATA_DIR
+    paths.emplace_back(std::string(POSEFUSE_DEFAULT_DATA_DIR) + "/kitti/06/times.txt");
+#endif
     for (const std::string& p : paths) {
       std::ifstream in(p);
       std::vector<double> t;

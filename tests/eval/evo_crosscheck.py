@@ -14,7 +14,7 @@ that tests/eval/test_metrics.cpp checks on KITTI 06:
     pairs chosen on the aligned estimate, statistics with numpy's population
     std and median.
 
-Usage: python3 tests/eval/evo_crosscheck.py [DATA_DIR]   (default ../shared/data)
+Usage: python3 tests/eval/evo_crosscheck.py [DATA_DIR]   (default: the data folder beside the checkout)
 """
 import math
 import os

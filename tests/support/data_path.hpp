@@ -1,5 +1,5 @@
 #pragma once
-// The one configurable path to the real datasets (see ../shared/data/README.md).
+// The one configurable path to the real datasets (layout: docs/programs.md).
 // Order: the POSEFUSE_DATA_DIR environment variable, else the CMake cache
 // variable POSEFUSE_DATA_DIR baked in at build time.
 #include <cstdlib>
