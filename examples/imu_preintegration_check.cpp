@@ -29,8 +29,13 @@
 // --json prints one object (position_error_rmse, rotation_error_rmse_deg,
 // velocity_error_rmse, nees_mean, ...); --svg FILE plots the per-window
 // errors with the covariance's 3-sigma. The noise densities default to the
-// EuRoC ADIS16448 figures of imu0_sensor.yaml. Exit status: 0 ok, 1 bad data
-// (file:line where a file is at fault), 2 bad usage.
+// EuRoC ADIS16448 figures of imu0_sensor.yaml; the white-noise densities
+// must be > 0 (a zero covariance cannot score a non-zero error). Windows end
+// on the ground-truth state nearest to their start + S; the length printed is
+// the median of the windows used. A window holding a ground-truth step longer
+// than 2.5 times the file's median step is skipped as a gap. Exit status: 0
+// ok, 1 bad data (file:line where a file is at fault), 2 bad usage
+// (including values that can only fail: zero noise, a window beyond 9e9 s).
 
 #include <algorithm>
 #include <cmath>
@@ -65,6 +70,37 @@ struct Options {
   bool json = false;
 };
 
+std::string short_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+/// Refuses values no run can succeed with, before any file is read.
+void check_ranges(const Options& o) {
+  // The window becomes integer nanoseconds: at most ~9.2e9 s, at least 1 ns.
+  if (o.window_s > 9e9)
+    throw apps::usage_error("--window " + short_number(o.window_s) +
+                            " s does not fit nanosecond stamps (at most 9e9 s)");
+  if (o.window_s < 1e-9)
+    throw apps::usage_error("--window " + short_number(o.window_s) + " s is shorter than 1 ns");
+  // A zero density gives a zero covariance for δp, δφ or δv: no error can be
+  // scored against it (its NEES is infinite). Squares of densities outside
+  // [1e-100, 1e100] under- or overflow the covariance.
+  const auto density = [](const char* flag, double v, bool zero_ok) {
+    if (zero_ok && v == 0.0) return;
+    if (v < 1e-100 || v > 1e100)
+      throw apps::usage_error(std::string(flag) + " " + short_number(v) +
+                              " is outside [1e-100, 1e100]" + (zero_ok ? " (or 0)" : ""));
+  };
+  density("--gyro-noise", o.noise.gyro_noise_density, false);
+  density("--accel-noise", o.noise.accel_noise_density, false);
+  density("--gyro-walk", o.noise.gyro_random_walk, true);
+  density("--accel-walk", o.noise.accel_random_walk, true);
+  if (o.gravity > 1e100)
+    throw apps::usage_error("--gravity " + short_number(o.gravity) + " m/s^2 is above 1e100");
+}
+
 std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   Options o;
   std::optional<std::filesystem::path> imu, gt;
@@ -79,12 +115,12 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
            apps::Domain::kPositive);
   cli.real({.name = "--gravity", .value = "G", .help = "gravity magnitude", .unit = "m/s^2"},
            o.gravity, apps::Domain::kPositive);
-  cli.real({.name = "--gyro-noise", .value = "X", .help = "gyroscope noise density",
+  cli.real({.name = "--gyro-noise", .value = "X", .help = "gyroscope noise density (> 0: a zero covariance cannot score an error)",
             .unit = "rad/s/sqrt(Hz)"},
-           o.noise.gyro_noise_density, apps::Domain::kNonNegative);
-  cli.real({.name = "--accel-noise", .value = "X", .help = "accelerometer noise density",
+           o.noise.gyro_noise_density, apps::Domain::kPositive);
+  cli.real({.name = "--accel-noise", .value = "X", .help = "accelerometer noise density (> 0)",
             .unit = "m/s^2/sqrt(Hz)"},
-           o.noise.accel_noise_density, apps::Domain::kNonNegative);
+           o.noise.accel_noise_density, apps::Domain::kPositive);
   cli.real({.name = "--gyro-walk", .value = "X", .help = "gyroscope bias random walk",
             .unit = "rad/s^2/sqrt(Hz)"},
            o.noise.gyro_random_walk, apps::Domain::kNonNegative);
@@ -96,6 +132,7 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   cli.epilogue("Exit status: 0 ok, 1 bad data (file:line where a file is at fault), 2 bad usage.");
   if (!cli.parse(cmd)) return std::nullopt;
   if (!imu || !gt) throw apps::usage_error("--imu and --groundtruth are required");
+  check_ranges(o);
   o.imu = *imu;
   o.groundtruth = *gt;
   return o;
@@ -128,6 +165,8 @@ Stats stats_of(std::vector<double> v) {
 
 struct Report {
   std::vector<Window> windows;
+  double window_s = 0;    // median length of the evaluated windows
+  double gt_step_s = 0;   // median step of the ground truth
   std::size_t skipped = 0;
   std::string first_skip_reason;
   double nees_mean = 0, nees_lo = 0, nees_hi = 0, inside = 0, win_lo = 0, win_hi = 0;
@@ -140,19 +179,39 @@ Report run_check(const Options& o) {
   if (!gt.has_velocity_and_biases())
     throw apps::data_error(o.groundtruth.string() +
                            ": needs velocity and biases (17 columns); this file has poses only");
-  const auto window_ns = std::int64_t(std::llround(o.window_s * 1e9));
+  const auto window_ns = std::int64_t(std::llround(o.window_s * 1e9));  // range checked
   const Eigen::Vector3d g_w(0, 0, -o.gravity);
   Report r;
-  posefuse::Preintegration pre(o.noise);
+  if (gt.size() < 2)
+    throw apps::data_error(o.groundtruth.string() + ": fewer than two ground-truth states");
+  // The file's own sampling period: a gap is a step longer than 2.5 of it,
+  // whatever the window.
+  std::vector<std::int64_t> steps;
+  for (std::size_t k = 1; k < gt.size(); ++k) steps.push_back(gt.t_ns[k] - gt.t_ns[k - 1]);
+  std::nth_element(steps.begin(), steps.begin() + std::ptrdiff_t(steps.size() / 2), steps.end());
+  const std::int64_t step_ns = steps[steps.size() / 2];
+  r.gt_step_s = double(step_ns) * 1e-9;
+  // (the stamps jitter by well under 1 % of the step)
+  if (window_ns < step_ns - step_ns / 100)
+    std::fprintf(stderr,
+                 "warning: --window %g s is shorter than the ground truth's period (%.4g s); each "
+                 "window is one ground-truth step\n",
+                 o.window_s, r.gt_step_s);
+  std::vector<double> lengths;
   std::size_t i = 0;
   while (i + 1 < gt.size()) {
+    // Windows end on the ground-truth state nearest to t_i + window (at
+    // least one step on), so the stamps' jitter does not add a step.
     std::size_t j = i + 1;
-    while (j < gt.size() && gt.t_ns[j] - gt.t_ns[i] < window_ns) ++j;
+    while (j < gt.size() && gt.t_ns[j] - gt.t_ns[i] < window_ns - step_ns / 2) ++j;
     if (j == gt.size()) break;
     const std::int64_t t0 = gt.t_ns[i], t1 = gt.t_ns[j];
     const std::size_t start = i;
     i = j;
-    if (double(t1 - t0) > 1.5 * double(window_ns)) {
+    bool gap = false;
+    for (std::size_t k = start + 1; k <= j; ++k)
+      gap = gap || double(gt.t_ns[k] - gt.t_ns[k - 1]) > 2.5 * double(step_ns);
+    if (gap) {
       ++r.skipped;
       if (r.first_skip_reason.empty()) r.first_skip_reason = "a ground-truth gap";
       continue;
@@ -175,7 +234,13 @@ Report run_check(const Options& o) {
                                    Ri_inv.act(vj - vi - g_w * T)};
     const Eigen::Matrix<double, 9, 1> e = truth.minus(p.delta());
     const Eigen::Matrix<double, 9, 9> P = p.covariance().topLeftCorner<9, 9>();
-    const Eigen::LDLT<Eigen::Matrix<double, 9, 9>> ldlt(P);
+    const Eigen::LLT<Eigen::Matrix<double, 9, 9>> llt(P);
+    const std::string at = short_number(posefuse::seconds_between(t0, gt.t_ns.front()));
+    if (!P.allFinite() || !e.allFinite())
+      throw apps::data_error("non-finite error or covariance in the window starting at t = " + at + " s");
+    if (llt.info() != Eigen::Success)
+      throw apps::data_error("the propagated covariance of the window at t = " + at +
+                             " s is not positive definite");
     Window w;
     w.t_s = posefuse::seconds_between(t0, gt.t_ns.front());
     w.pos_m = e.head<3>().norm();
@@ -183,14 +248,15 @@ Report run_check(const Options& o) {
     w.vel_mps = e.tail<3>().norm();
     w.pos_3sigma_m = 3.0 * std::sqrt(P.topLeftCorner<3, 3>().trace());
     w.rot_3sigma_deg = 3.0 * std::sqrt(P.block<3, 3>(3, 3).trace()) * 180.0 / std::numbers::pi;
-    w.nees = e.dot(ldlt.solve(e));
+    w.nees = e.dot(llt.solve(e));
     if (!std::isfinite(w.nees) || !std::isfinite(w.pos_m))
       throw apps::data_error("non-finite error in the window starting at t = " +
-                             std::to_string(t0) + " ns");
+                             short_number(posefuse::seconds_between(t0, gt.t_ns.front())) + " s");
     r.windows.push_back(w);
+    lengths.push_back(double(t1 - t0) * 1e-9);
   }
   if (r.windows.empty())
-    throw apps::data_error("no window of " + std::to_string(o.window_s) +
+    throw apps::data_error("no window of " + short_number(o.window_s) +
                            " s could be evaluated (first reason: " +
                            (r.first_skip_reason.empty() ? std::string("sequence too short")
                                                         : r.first_skip_reason) +
@@ -207,6 +273,8 @@ Report run_check(const Options& o) {
     nees_sum += w.nees;
     if (w.nees >= r.win_lo && w.nees <= r.win_hi) ++inside;
   }
+  std::nth_element(lengths.begin(), lengths.begin() + std::ptrdiff_t(lengths.size() / 2), lengths.end());
+  r.window_s = lengths[lengths.size() / 2];
   const int n = int(r.windows.size());
   r.pos = stats_of(pos);
   r.rot = stats_of(rot);
@@ -244,9 +312,10 @@ std::string plot_svg(const Report& r) {
 }
 
 void print_table(const Options& o, const Report& r) {
-  std::printf("IMU pre-integration vs ground truth: %zu windows of %g s (%zu skipped%s%s)\n",
-              r.windows.size(), o.window_s, r.skipped, r.skipped ? ", first: " : "",
-              r.first_skip_reason.c_str());
+  std::printf("IMU pre-integration vs ground truth: %zu windows of %.4g s", r.windows.size(), r.window_s);
+  if (std::abs(r.window_s - o.window_s) > 1e-3 * o.window_s)
+    std::printf(" (asked %g s; ground-truth states are %.4g s apart)", o.window_s, r.gt_step_s);
+  std::printf(" (%zu skipped%s%s)\n", r.skipped, r.skipped ? ", first: " : "", r.first_skip_reason.c_str());
   std::printf("error                 rmse    median       p95       max\n");
   const auto row = [](const char* name, const Stats& s) {
     std::printf("%-16s %9.4f %9.4f %9.4f %9.4f\n", name, s.rmse, s.median, s.p95, s.max);
@@ -263,7 +332,8 @@ void print_table(const Options& o, const Report& r) {
 void print_json(const Options& o, const Report& r) {
   apps::JsonWriter j(std::cout);
   j.begin_object(apps::JsonWriter::Layout::kInline);
-  j.member("window_s", o.window_s).member("windows", r.windows.size()).member("skipped", r.skipped);
+  j.member("window_s", r.window_s).member("window_asked_s", o.window_s);
+  j.member("windows", r.windows.size()).member("skipped", r.skipped);
   j.member("position_error_rmse", r.pos.rmse).member("position_error_median", r.pos.median);
   j.member("position_error_max", r.pos.max);
   j.member("rotation_error_rmse_deg", r.rot.rmse).member("rotation_error_median_deg", r.rot.median);

@@ -32,9 +32,13 @@
 //   gyro bias [rad/s]         ...
 //
 // --json prints scale_error_percent, gravity_error_deg, gyro_bias_error,
-// velocity_error (medians over the successful windows), success_rate and
-// the status counts; --svg FILE plots the per-window errors. Exit status: 0
-// ok, 1 bad data (file:line where a file is at fault), 2 bad usage.
+// velocity_error (medians over the successful windows; null, and "no
+// successful window" in the table, when none succeeded: a 0 % success rate
+// is a result, exit 0), success_rate and the status counts; --svg FILE plots
+// the per-window errors. An interval shorter than the ground truth's period
+// is reported as a warning and the period is printed as the interval used.
+// Exit status: 0 ok, 1 bad data (file:line where a file is at fault), 2 bad
+// usage (including values that can only fail: an interval beyond 9e9 s).
 
 #include <algorithm>
 #include <array>
@@ -75,6 +79,31 @@ struct Options {
   bool json = false;
 };
 
+std::string short_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+/// Refuses values no run can succeed with, before any file is read.
+void check_ranges(const Options& o) {
+  // The interval becomes integer nanoseconds: at most ~9.2e9 s, at least 1 ns.
+  if (o.keyframe_interval_s > 9e9)
+    throw apps::usage_error("--keyframe-interval " + short_number(o.keyframe_interval_s) +
+                            " s does not fit nanosecond stamps (at most 9e9 s)");
+  if (o.keyframe_interval_s < 1e-9)
+    throw apps::usage_error("--keyframe-interval " + short_number(o.keyframe_interval_s) +
+                            " s is shorter than 1 ns");
+  // Scaled positions and their squares must stay finite in the alignment.
+  if (o.sfm_scale < 1e-100 || o.sfm_scale > 1e100)
+    throw apps::usage_error("--sfm-scale " + short_number(o.sfm_scale) + " is outside [1e-100, 1e100]");
+  // A rotation noise beyond half a turn is no longer a noise about the pose.
+  if (o.rot_noise_deg > 180)
+    throw apps::usage_error("--rot-noise-deg " + short_number(o.rot_noise_deg) + " is above 180");
+  if (o.pos_noise_m > 1e100)
+    throw apps::usage_error("--pos-noise " + short_number(o.pos_noise_m) + " m is above 1e100");
+}
+
 std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   Options o;
   std::optional<std::filesystem::path> imu, gt;
@@ -109,6 +138,7 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   if (!cli.parse(cmd)) return std::nullopt;
   if (!imu || !gt) throw apps::usage_error("--imu and --groundtruth are required");
   if (o.stride < 1) throw apps::usage_error("--stride must be >= 1");
+  check_ranges(o);
   o.imu = *imu;
   o.groundtruth = *gt;
   return o;
@@ -133,6 +163,7 @@ struct WindowResult {
 
 struct Report {
   std::vector<WindowResult> windows;
+  double keyframe_interval_s = 0;  // what was used: the asked one, or the ground truth's period
   std::size_t skipped = 0;
   std::map<std::string, std::size_t> statuses;
 };
@@ -148,7 +179,23 @@ Report run_check(const Options& o) {
     throw apps::data_error(o.groundtruth.string() +
                            ": needs velocity and biases (17 columns); this file has poses only");
   // Keyframes: ground-truth states at least keyframe_interval apart.
-  const auto interval_ns = std::int64_t(std::llround(o.keyframe_interval_s * 1e9));
+  const auto interval_ns = std::int64_t(std::llround(o.keyframe_interval_s * 1e9));  // range checked
+  Report r;
+  r.keyframe_interval_s = o.keyframe_interval_s;
+  if (gt.size() >= 2) {
+    std::vector<std::int64_t> steps;
+    for (std::size_t k = 1; k < gt.size(); ++k) steps.push_back(gt.t_ns[k] - gt.t_ns[k - 1]);
+    std::nth_element(steps.begin(), steps.begin() + std::ptrdiff_t(steps.size() / 2), steps.end());
+    const std::int64_t step_ns = steps[steps.size() / 2];
+    // (the stamps jitter by well under 1 % of the step)
+    if (interval_ns < step_ns - step_ns / 100) {
+      r.keyframe_interval_s = double(step_ns) * 1e-9;
+      std::fprintf(stderr,
+                   "warning: --keyframe-interval %g s is shorter than the ground truth's period "
+                   "(%.4g s); every ground-truth state is a keyframe\n",
+                   o.keyframe_interval_s, r.keyframe_interval_s);
+    }
+  }
   std::vector<std::size_t> kf;
   for (std::size_t i = 0; i < gt.size(); ++i)
     if (kf.empty() || gt.t_ns[i] - gt.t_ns[kf.back()] >= interval_ns) kf.push_back(i);
@@ -156,7 +203,6 @@ Report run_check(const Options& o) {
   std::mt19937_64 rng(o.seed);
   std::normal_distribution<double> n01(0.0, 1.0);
   const double sigma_r = o.rot_noise_deg * std::numbers::pi / 180.0;
-  Report r;
   for (std::size_t w0 = 0; w0 + kFrames <= kf.size(); w0 += std::size_t(o.stride)) {
     std::array<posefuse::SE3d, kFrames> T_w_c;
     for (int k = 0; k < kFrames; ++k) {
@@ -208,7 +254,7 @@ Report run_check(const Options& o) {
       wr.gyro_bias = (res.gyro_bias - (*gt.gyro_bias)[kf[w0]]).norm();
       if (!std::isfinite(wr.scale_pct) || !std::isfinite(wr.velocity_rms))
         throw apps::data_error("non-finite alignment result in the window at t = " +
-                               std::to_string(wr.t_s) + " s");
+                               short_number(wr.t_s) + " s");
     }
     r.windows.push_back(wr);
   }
@@ -278,10 +324,14 @@ std::string plot_svg(const Report& r) {
 void print_table(const Options& o, const Report& r, const Summary& s) {
   std::printf("Visual-inertial alignment, windows of %d keyframes %g s apart (stride %d): %zu "
               "windows (%zu skipped)\n",
-              kFrames, o.keyframe_interval_s, o.stride, r.windows.size(), r.skipped);
+              kFrames, r.keyframe_interval_s, o.stride, r.windows.size(), r.skipped);
   std::printf("status:");
   for (const auto& kv : r.statuses) std::printf(" %s %zu;", kv.first.c_str(), kv.second);
   std::printf(" success rate %.1f %%\n", 100.0 * s.success_rate);
+  if (s.ok == 0) {
+    std::printf("no successful window: no error to summarise\n");
+    return;
+  }
   std::printf("error (ok windows)          median       p95       max\n");
   const auto row = [](const char* name, const Dist& d, const char* fmt) {
     std::printf("%-24s", name);
@@ -296,15 +346,23 @@ void print_table(const Options& o, const Report& r, const Summary& s) {
   row("gyro bias [rad/s]", s.gyro, " %9.5f");
 }
 
-void print_json(const Options& o, const Report& r, const Summary& s) {
+void print_json(const Options&, const Report& r, const Summary& s) {
   apps::JsonWriter j(std::cout);
   j.begin_object(apps::JsonWriter::Layout::kInline);
-  j.member("keyframes", kFrames).member("keyframe_interval_s", o.keyframe_interval_s);
+  j.member("keyframes", kFrames).member("keyframe_interval_s", r.keyframe_interval_s);
   j.member("windows", r.windows.size()).member("skipped", r.skipped);
   j.member("success_rate", s.success_rate);
-  j.member("scale_error_percent", s.scale.median).member("scale_error_percent_p95", s.scale.p95);
-  j.member("gravity_error_deg", s.gravity.median).member("gravity_error_deg_p95", s.gravity.p95);
-  j.member("velocity_error", s.velocity.median).member("gyro_bias_error", s.gyro.median);
+  // With no successful window there is no error to summarise: null.
+  const auto figure = [&](const char* name, double v) {
+    if (s.ok == 0) j.key(name).null();
+    else j.member(name, v);
+  };
+  figure("scale_error_percent", s.scale.median);
+  figure("scale_error_percent_p95", s.scale.p95);
+  figure("gravity_error_deg", s.gravity.median);
+  figure("gravity_error_deg_p95", s.gravity.p95);
+  figure("velocity_error", s.velocity.median);
+  figure("gyro_bias_error", s.gyro.median);
   j.key("statuses").begin_object(apps::JsonWriter::Layout::kInline);
   for (const auto& kv : r.statuses) j.member(kv.first, kv.second);
   j.end_object();
