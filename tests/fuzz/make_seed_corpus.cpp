@@ -23,6 +23,8 @@
 
 #include <posefuse/core/error.hpp>
 #include <posefuse/core/trajectory.hpp>
+#include <posefuse/io/euroc.hpp>
+#include <posefuse/io/g2o.hpp>
 #include <posefuse/io/kitti.hpp>
 #include <posefuse/io/robot_log.hpp>
 #include <posefuse/io/tum.hpp>
@@ -164,6 +166,93 @@ void tum_seeds(const fs::path& out, const fs::path& tmp) {
   seed("bad_far_from_unit", "0 0 0 0 0 0 0 1.1\n");
   seed("bad_not_increasing", "1 0 0 0 0 0 0 1\n0.5 0 0 0 0 0 0 1\n");
   seed("bad_seven_numbers", "1 0 0 0 0 0 1\n");
+}
+
+// --- g2o 2-D graphs and 4-DoF loop edges ----------------------------------------
+
+void g2o_seeds(const fs::path& out, const fs::path& tmp) {
+  const fs::path dir = out / "fuzz_g2o";
+  posefuse::G2oGraph2d g;
+  for (int k = 0; k < 5; ++k) g.vertices.push_back({k, 0.5 * k, 0.1 * k, 0.2 * k, 0});
+  for (int k = 0; k + 1 < 5; ++k) {
+    posefuse::G2oEdgeSE2 e;
+    e.from = k;
+    e.to = k + 1;
+    e.dx = 0.5;
+    e.dy = 0.1;
+    e.dtheta = 0.2;
+    e.information = Eigen::Vector3d(100, 100, 400).asDiagonal();
+    g.edges.push_back(e);
+  }
+  g.fixed.push_back(0);
+  posefuse::write_g2o_2d(tmp / "g.g2o", g);
+  std::vector<posefuse::LoopEdge4DofRecord> loops(2);
+  loops[0].from = 10;
+  loops[0].to = 150;
+  loops[0].dp = Eigen::Vector3d(0.1, -0.2, 0.05);
+  loops[0].dyaw = 0.3;
+  loops[0].information = Eigen::Vector4d(100, 100, 100, 400).asDiagonal();
+  loops[1].from = 42;
+  loops[1].to = 7;
+  posefuse::write_loop_edges_4dof(tmp / "l.txt", loops);
+  // The first byte chooses the reader: '0' (even) the 2-D graph, '1' (odd) the loops.
+  const auto seed = [&](const std::string& name, char reader, const std::string& s) {
+    put(dir, name, std::string(1, reader) + s);
+    expect("fuzz_g2o/" + name, [&] {
+      posefuse_fuzz::write_bytes(tmp / "s.txt", s);
+      if (reader == '0') (void)posefuse::read_g2o_2d(tmp / "s.txt");
+      else (void)posefuse::read_loop_edges_4dof(tmp / "s.txt");
+    });
+  };
+  seed("valid_written_graph", '0', slurp(tmp / "g.g2o"));
+  seed("valid_edges_before_vertices_crlf", '0',
+       "EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\r\nVERTEX_SE2 1 1 0 0\r\nVERTEX_SE2 0 0 0 0\r\n");
+  seed("bad_unknown_tag", '0', "VERTEX_SE3:QUAT 0 0 0 0 0 0 0 1\n");
+  seed("bad_self_edge", '0', "VERTEX_SE2 0 0 0 0\nEDGE_SE2 0 0 1 0 0 1 0 0 1 0 1\n");
+  seed("bad_missing_vertex", '0', "VERTEX_SE2 0 0 0 0\nEDGE_SE2 0 9 1 0 0 1 0 0 1 0 1\n");
+  seed("bad_not_psd", '0', "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 0 0 0\nEDGE_SE2 0 1 1 0 0 1 5 0 1 0 1\n");
+  seed("bad_duplicate_vertex", '0', "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 0 1 0 0\n");
+  seed("valid_written_loops", '1', slurp(tmp / "l.txt"));
+  seed("bad_loop_fifteen_fields", '1', "10 150 0 0 0 0 100 0 0 0 100 0 0 100 0\n");
+  seed("bad_loop_self", '1', "3 3 0 0 0 0 100 0 0 0 100 0 0 100 0 400\n");
+  seed("bad_loop_huge_id", '1', "99999999999999999999 1 0 0 0 0 100 0 0 0 100 0 0 100 0 400\n");
+}
+
+// --- EuRoC IMU and ground truth ---------------------------------------------------
+
+void euroc_seeds(const fs::path& out, const fs::path& tmp) {
+  const fs::path dir = out / "fuzz_euroc";
+  std::ostringstream imu, gt;
+  imu << "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],"
+         "a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\n";
+  gt << "#timestamp,p_x,p_y,p_z,q_w,q_x,q_y,q_z,v_x,v_y,v_z,bw_x,bw_y,bw_z,ba_x,ba_y,ba_z\n";
+  imu.precision(17);
+  gt.precision(17);
+  const std::int64_t t0 = 1403715273262142976;
+  for (int k = 0; k < 8; ++k) {
+    const double a = 0.1 * k;
+    imu << t0 + 5000000LL * k << ',' << 0.01 * k << ",-0.02,0.07," << 9.08 + 0.01 * k << ",0.13,-3.69\n";
+    gt << t0 + 50000128LL * k << ',' << a << ",2.18,0.95," << std::cos(a / 2) << ",0,0," << std::sin(a / 2)
+       << ",0.1,0,0,-0.002,0.02,0.077,-0.018,0.066,0.031\n";
+  }
+  const auto seed = [&](const std::string& name, const std::string& i, const std::string& g) {
+    put(dir, name, join_files({i, g}));
+    expect("fuzz_euroc/" + name, [&] {
+      posefuse_fuzz::write_bytes(tmp / "i.csv", i);
+      posefuse_fuzz::write_bytes(tmp / "g.csv", g);
+      (void)posefuse::read_euroc_imu(tmp / "i.csv");
+      (void)posefuse::read_euroc_groundtruth(tmp / "g.csv");
+    });
+  };
+  seed("valid_generated", imu.str(), gt.str());
+  seed("valid_pose_only_crlf", imu.str(),
+       "1000,0,0,0,1,0,0,0\r\n2000,1,0,0,0.70710678118654757,0,0,0.70710678118654757\r\n");
+  seed("bad_imu_backwards", "2000,0,0,0,0,0,9.81\n1000,0,0,0,0,0,9.81\n", gt.str());
+  seed("bad_imu_nan", "1000,0,0,nan,0,0,9.81\n", gt.str());
+  seed("bad_imu_six_fields", "1000,0,0,0,0,9.81\n", gt.str());
+  seed("bad_gt_zero_quaternion", imu.str(), "1000,0,0,0,0,0,0,0\n");
+  seed("bad_gt_field_count_changes", imu.str(), "1000,0,0,0,1,0,0,0\n2000,0,0,0,1,0,0,0,0\n");
+  seed("bad_gt_stamp_overflow", imu.str(), "99999999999999999999,0,0,0,1,0,0,0\n");
 }
 
 // --- robot log ---------------------------------------------------------------
@@ -361,6 +450,8 @@ int main(int argc, char** argv) {
   const posefuse_fuzz::ScratchDir tmp("seed-corpus");
   kitti_seeds(out, tmp.path());
   tum_seeds(out, tmp.path());
+  g2o_seeds(out, tmp.path());
+  euroc_seeds(out, tmp.path());
   robot_log_seeds(out, tmp.path());
   ekf_seeds(out);
   if (g_errors > 0) {
