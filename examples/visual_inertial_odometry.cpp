@@ -57,6 +57,12 @@ struct Options {
   int iterations = 10;
   std::string loss = "cauchy";
   bool estimate_extrinsic = false;
+  bool no_fej = false;
+  bool no_reuse = false;
+  double min_parallax_px = 10.0;
+  double outlier_px = 3.0;
+  std::size_t max_frames = 0;
+  posefuse::ImuNoise noise;  // the EuRoC IMU's datasheet figures (imu0 sensor.yaml)
   bool json = false;
 };
 
@@ -91,6 +97,35 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
              });
   cli.flag({.name = "--estimate-extrinsic", .help = "estimate the camera-IMU extrinsic too"},
            o.estimate_extrinsic);
+  cli.flag({.name = "--no-first-estimate-jacobians",
+            .help = "linearise every factor at the current estimate (VINS-Mono's way)"},
+           o.no_fej);
+  cli.flag({.name = "--no-track-reuse",
+            .help = "do not re-anchor the tracks of a marginalised keyframe's features"},
+           o.no_reuse);
+  cli.real({.name = "--min-parallax", .value = "PX", .help = "keyframe parallax", .default_text = "10"},
+           o.min_parallax_px, apps::Domain::kPositive);
+  cli.real({.name = "--outlier-px", .value = "PX", .help = "reprojection error of an outlier",
+            .default_text = "3"},
+           o.outlier_px, apps::Domain::kPositive);
+  cli.custom({.name = "--imu-noise", .value = "NA,NG,WA,WG",
+              .help = "accelerometer and gyroscope noise densities, then their random walks\n"
+                      "(m/s^2/sqrt(Hz), rad/s/sqrt(Hz), m/s^3/sqrt(Hz), rad/s^2/sqrt(Hz))",
+              .default_text = "2e-3,1.6968e-4,3e-3,1.9393e-5"},
+             [&](std::string_view v) {
+               double x[4];
+               std::size_t start = 0;
+               for (int i = 0; i < 4; ++i) {
+                 const std::size_t comma = i < 3 ? v.find(',', start) : v.size();
+                 if (comma == std::string_view::npos || (i == 3 && v.find(',', start) != std::string_view::npos))
+                   throw apps::usage_error("expected four comma-separated numbers, got '" + std::string(v) + "'");
+                 x[i] = apps::parse_real(v.substr(start, comma - start), apps::Domain::kPositive);
+                 start = comma + 1;
+               }
+               o.noise = posefuse::ImuNoise{x[1], x[0], x[3], x[2]};
+             });
+  cli.integer({.name = "--max-frames", .value = "N", .help = "stop after N frames (0: all)"}, o.max_frames,
+              std::size_t{0});
   cli.flag({.name = "--json", .help = "print one JSON object instead of the table"}, o.json);
   cli.epilogue("Exit status: 0 ok, 1 bad data (file:line where a file is at fault), 2 bad usage.");
   if (!cli.parse(cmd)) return std::nullopt;
@@ -135,6 +170,11 @@ int run(const Options& o) {
   eo.window.solve.loss.kind = o.loss == "cauchy"  ? posefuse::ReprojectionLoss::Kind::kCauchy
                               : o.loss == "huber" ? posefuse::ReprojectionLoss::Kind::kHuber
                                                   : posefuse::ReprojectionLoss::Kind::kNone;
+  eo.noise = o.noise;
+  eo.window.solve.first_estimate_jacobians = !o.no_fej;
+  eo.window.reuse_marginalised_tracks = !o.no_reuse;
+  eo.window.min_parallax_px = o.min_parallax_px;
+  eo.window.outlier_threshold_px = o.outlier_px;
   eo.preintegration.max_gap_ns = std::int64_t(std::llround(o.max_imu_gap_ms * 1e6));
   posefuse::VioEstimator est(cam, eo);
   if (o.estimate_extrinsic) est.set_estimate_extrinsic(true);
@@ -146,6 +186,7 @@ int run(const Options& o) {
   std::size_t k = 0;
   double total_ms = 0;
   for (std::size_t f = 0; f < tracks.size(); ++f) {
+    if (o.max_frames > 0 && f >= o.max_frames) break;
     const posefuse::TrackFrame& frame = tracks[f];
     // IMU up to the first sample at or after the frame (the pre-integration interpolates).
     while (k < imu.size() && (k == 0 || imu[k - 1].t_ns < frame.t_ns)) est.add_imu(imu[k++]);
