@@ -17,7 +17,7 @@
 /// model's `noise()`, or `noise(x)` at the prior state when the model has it
 /// (state-dependent noise, core/concepts.hpp).
 ///
-/// **Solving with S.** For 1x1 and 2x2 innovations S is tested by
+/// **Solving with S** (core/spd_solver.hpp). For 1x1 and 2x2 innovations S is tested by
 /// Sylvester's criterion and inverted in closed form (a few flops). Larger
 /// ones are factorised, \f$ S = L D L^\top \f$ (no square roots), and K and the NIS
 /// \f$ r^\top S^{-1} r \f$ are computed by solving with L; no inverse is
@@ -59,41 +59,15 @@
 #include <posefuse/core/concepts.hpp>
 #include <posefuse/core/error.hpp>
 #include <posefuse/core/gaussian.hpp>
+#include <posefuse/core/spd_solver.hpp>
 #include <posefuse/core/status.hpp>
+#include <posefuse/filters/ekf_options.hpp>
+#include <posefuse/filters/ekf_update_result.hpp>
 #include <tuple>
 #include <type_traits>
 
 namespace posefuse {
 
-/// What an update did, with its innovation statistics (valid whenever S could
-/// be formed, also for gated updates).
-template <MeasurementModel H>
-struct UpdateResult {
-  using Innovation = TangentOf<typename H::Measurement>;
-  using InnovationCovariance = CovarianceOf<typename H::Measurement>;
-
-  FilterStatus status = FilterStatus::kNonFinite;
-  Innovation innovation = Innovation::Zero();  ///< \f$ r = z \boxminus h(\bar x) \f$
-  InnovationCovariance S = InnovationCovariance::Zero();  ///< \f$ H P H^\top + R \f$
-  ScalarOf<typename H::State> nis = std::numeric_limits<ScalarOf<typename H::State>>::quiet_NaN();
-
-  /// True when the update was applied.
-  [[nodiscard]] explicit operator bool() const noexcept { return status == FilterStatus::kApplied; }
-};
-
-/// A gate for updates with measurement model H: a NIS threshold (any
-/// arithmetic type), or a functor `bool(const Innovation& r, const
-/// InnovationCovariance& S)` or `bool(r, S, Scalar nis)` returning true to
-/// accept the measurement.
-template <class G, class H>
-concept InnovationGate =
-    MeasurementModel<H> &&
-    ((std::is_arithmetic_v<G> && !std::is_same_v<G, bool>) ||
-     std::is_invocable_r_v<bool, const G&, const typename UpdateResult<H>::Innovation&,
-                           const typename UpdateResult<H>::InnovationCovariance&> ||
-     std::is_invocable_r_v<bool, const G&, const typename UpdateResult<H>::Innovation&,
-                           const typename UpdateResult<H>::InnovationCovariance&,
-                           ScalarOf<typename H::State>>);
 
 namespace detail {
 template <class T, class... Ts>
@@ -131,144 +105,6 @@ consteval bool state_matches() {
   }
 }
 
-/// The positive-definiteness test and the solves with an innovation
-/// covariance S (see the file comment). Sizes 1 and 2 keep S⁻¹ in closed
-/// form; larger sizes keep the factors of S = L D Lᵀ and never form S⁻¹.
-template <class Mat, int N = Mat::RowsAtCompileTime>
-class SpdSolver {
-  using T = typename Mat::Scalar;
-  using Vec = Eigen::Matrix<T, N, 1>;
-
- public:
-  /// Factorises S. @return false (solver unusable) unless S is positive definite
-  [[nodiscard, gnu::always_inline]] bool compute(const Mat& S) {
-    if constexpr (N == 1) {
-      if (!(S(0, 0) > T(0))) return false;
-      recip_ = T(1) / S(0, 0);
-      inv_(0, 0) = recip_;
-      return true;
-    } else if constexpr (N == 2) {
-      const T det = S(0, 0) * S(1, 1) - S(0, 1) * S(1, 0);
-      if (!(S(0, 0) > T(0) && det > T(2) * std::numeric_limits<T>::epsilon() * S(0, 0) * S(1, 1)))
-        return false;
-      const T r = T(1) / det;
-      recip_ = r;
-      inv_(0, 0) = S(1, 1) * r;
-      inv_(1, 1) = S(0, 0) * r;
-      inv_(0, 1) = -S(0, 1) * r;
-      inv_(1, 0) = -S(1, 0) * r;
-      return true;
-    } else {
-      // S = L D L^T (L unit lower triangular), column by column, from the
-      // lower triangle of S; no square roots, 1 / d_j kept so that the
-      // solves below multiply. d_j is the squared Cholesky pivot L_jj^2.
-      const T tol = T(N) * std::numeric_limits<T>::epsilon();
-      for (int j = 0; j < N; ++j) {
-        T d = S(j, j);
-        for (int k = 0; k < j; ++k) d -= L_(j, k) * LD_(j, k);
-        // The pivot criterion of the file comment (NaN fails).
-        if (!(d > tol * S(j, j))) return false;
-        inv_diag_(j) = T(1) / d;
-        for (int i = j + 1; i < N; ++i) {
-          T v = S(i, j);
-          for (int k = 0; k < j; ++k) v -= L_(i, k) * LD_(j, k);
-          LD_(i, j) = v;                    // L_ij d_j
-          L_(i, j) = v * inv_diag_(j);
-        }
-      }
-      return true;
-    }
-  }
-  /// Sizes 1 and 2: sets the state compute() leaves for a positive definite
-  /// S, from \f$ S^{-1} \f$ and \f$ 1 / \det S \f$ computed as compute() does.
-  void set_closed_form(const T (&inv)[N][N], T recip) noexcept
-    requires(N <= 2)
-  {
-    for (int i = 0; i < N; ++i)
-      for (int j = 0; j < N; ++j) inv_(i, j) = inv[i][j];
-    recip_ = recip;
-  }
-  /// Sizes 1 and 2: \f$ 1 / \det S \f$ (S⁻¹ = adj(S) / det S), after compute().
-  [[nodiscard]] T recip_det() const noexcept
-    requires(N <= 2)
-  {
-    return recip_;
-  }
-  /// \f$ r^\top S^{-1} r = \sum_j y_j^2 / d_j,\; y = L^{-1} r \f$.
-  [[nodiscard, gnu::always_inline]] T nis(const Vec& r) const {
-    if constexpr (N == 1) {
-      return r(0) * (inv_(0, 0) * r(0));
-    } else if constexpr (N == 2) {
-      return r(0) * (inv_(0, 0) * r(0) + inv_(0, 1) * r(1)) +
-             r(1) * (inv_(1, 0) * r(0) + inv_(1, 1) * r(1));
-    } else {
-      Vec y;
-      T sum = T(0);
-      for (int j = 0; j < N; ++j) {
-        T v = r(j);
-        for (int k = 0; k < j; ++k) v -= L_(j, k) * y(k);
-        y(j) = v;
-        sum += v * v * inv_diag_(j);
-      }
-      return sum;
-    }
-  }
-  /// \f$ A S^{-1} \f$ for an M x N matrix A (rows solved with L, then L^T).
-  template <int M>
-  [[nodiscard, gnu::always_inline]] Eigen::Matrix<T, M, N> right_solve(
-      const Eigen::Matrix<T, M, N>& A) const {
-    if constexpr (N <= 2) {
-      return A * inv_;
-    } else {
-      // X S = A  <=>  (X L D) L^T = A: Y L^T = A forward, Y D^-1, then
-      // X L = Y D^-1 backward (L unit lower triangular).
-      Eigen::Matrix<T, M, N> X;
-      for (int j = 0; j < N; ++j) {
-        Eigen::Matrix<T, M, 1> v = A.col(j);
-        for (int k = 0; k < j; ++k) v -= L_(j, k) * X.col(k);
-        X.col(j) = v;
-      }
-      for (int j = N - 1; j >= 0; --j) {
-        Eigen::Matrix<T, M, 1> v = X.col(j) * inv_diag_(j);
-        for (int k = j + 1; k < N; ++k) v -= L_(k, j) * X.col(k);
-        X.col(j) = v;
-      }
-      return X;
-    }
-  }
-
- private:
-  struct Empty {};
-  using Inverse = std::conditional_t<(N <= 2), Mat, Empty>;
-  static Inverse zero_inverse() {
-    if constexpr (N <= 2) {
-      return Mat::Zero();
-    } else {
-      return Empty{};
-    }
-  }
-  using Factor = std::conditional_t<(N <= 2), Empty, Mat>;
-  using InvDiag = std::conditional_t<(N <= 2), Empty, Vec>;
-  static Factor zero_factor() {
-    if constexpr (N <= 2) {
-      return Empty{};
-    } else {
-      return Mat::Zero();
-    }
-  }
-  static InvDiag zero_inv_diag() {
-    if constexpr (N <= 2) {
-      return Empty{};
-    } else {
-      return Vec::Zero();
-    }
-  }
-  [[no_unique_address]] Inverse inv_ = zero_inverse();
-  T recip_ = T(0);  // 1 / det S (sizes 1 and 2)
-  [[no_unique_address]] Factor L_ = zero_factor();   // unit lower triangular L
-  [[no_unique_address]] Factor LD_ = zero_factor();  // L_ij d_j (i > j)
-  [[no_unique_address]] InvDiag inv_diag_ = zero_inv_diag();
-};
 
 /// Placeholder measurement type for update_with() with a type that names none.
 struct NotAMeasurementModel {};
@@ -283,68 +119,6 @@ struct measurement_of<H> {
 };
 }  // namespace detail
 
-/// How an Ekf forms the posterior covariance (EkfOptions::kCovarianceUpdate).
-enum class CovarianceUpdate : std::uint8_t {
-  /// Joseph's form \f$ (I - K H) P (I - K H)^\top + K R K^\top \f$ (Bucy &
-  /// Joseph 1968; Grewal & Andrews, *Kalman Filtering*, 4th ed., eq. 4.23):
-  /// PSD for any gain, so round-off in K does not make P indefinite. The
-  /// default. Cost over kStandard: one Dim x Dim x M product more (one
-  /// triangle of it), e.g. +20 multiplications for Dim 4, M 2. For a
-  /// selection H with one or two rows it is evaluated expanded, \f$ P - K H P
-  /// - P H^\top K^\top + K S K^\top \f$ (equal for a symmetric P; see
-  /// small_selection_step).
-  kJoseph,
-  /// The textbook \f$ (I - K H) P \f$ (one triangle, mirrored): fewer
-  /// flops; exact only for the optimal gain, so round-off can leave P
-  /// indefinite on ill-conditioned problems (the filter then refuses the
-  /// step with kNotPositiveDefinite rather than store it).
-  kStandard,
-};
-
-/// When an Ekf computes the NIS \f$ r^\top S^{-1} r \f$ of an update
-/// (EkfOptions::kNis).
-enum class NisPolicy : std::uint8_t {
-  kAlways,     ///< every update: UpdateResult::nis is always set (the default)
-  kWhenGated,  ///< only when a NIS gate is finite or a gate functor takes the
-               ///< NIS; otherwise UpdateResult::nis stays NaN (saves one solve with S)
-};
-
-/// Compile-time options of BasicEkf. Derive from it and hide the members you
-/// change; the defaults are the safe choices, and `Ekf<Motion, Sensors...>`
-/// is BasicEkf with these defaults:
-/// ```cpp
-/// struct FastOptions : posefuse::EkfOptions {
-///   static constexpr auto kNis = posefuse::NisPolicy::kWhenGated;
-///   static constexpr bool kRecordJacobian = false;  // no smoother reads last_jacobian()
-/// };
-/// posefuse::BasicEkf<FastOptions, Motion, Sensor> ekf(motion, sensor);
-/// ```
-struct EkfOptions {
-  /// Posterior covariance form (Joseph by default; see CovarianceUpdate).
-  static constexpr CovarianceUpdate kCovarianceUpdate = CovarianceUpdate::kJoseph;
-  /// NIS computation (always by default; see NisPolicy).
-  static constexpr NisPolicy kNis = NisPolicy::kAlways;
-  /// Keep the state Jacobian F of the last applied prediction for
-  /// last_jacobian() (RTS smoothing). Cost: one Dim x Dim copy per predict,
-  /// plus a `jacobian()` call for models that propagate the covariance
-  /// themselves (HasPropagate). Off: last_jacobian() does not compile.
-  static constexpr bool kRecordJacobian = true;
-  /// Steady-state gain memo for time-invariant models (kTimeInvariant):
-  /// keep the covariance half of the update and reuse it, bit for bit,
-  /// while P repeats (kept once the same P has been seen twice in a row).
-  /// Cost: one Dim x Dim comparison per update and, per model, a Dim x Dim
-  /// copy of P whenever P changed; the gain is copied once per new steady state.
-  static constexpr bool kGainMemo = true;
-};
-
-/// A type usable as BasicEkf's options (see EkfOptions).
-template <class O>
-concept EkfOptionSet = requires {
-  { O::kCovarianceUpdate } -> std::convertible_to<CovarianceUpdate>;
-  { O::kNis } -> std::convertible_to<NisPolicy>;
-  { O::kRecordJacobian } -> std::convertible_to<bool>;
-  { O::kGainMemo } -> std::convertible_to<bool>;
-};
 
 /// An EKF over `Motion` with measurement models `Sensors...` and
 /// compile-time options `Options` (EkfOptions or a type derived from it);

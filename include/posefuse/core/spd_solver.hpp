@@ -1,0 +1,162 @@
+#pragma once
+/// @file
+/// detail::SpdSolver: the positive-definiteness test of a small symmetric
+/// matrix S of fixed size and the solves with it, for the innovation
+/// covariance of a Kalman update (filters/ekf.hpp).
+///
+/// For sizes 1 and 2, S is tested by Sylvester's criterion and inverted in
+/// closed form (a few flops). Larger ones are factorised,
+/// \f$ S = L D L^\top \f$ (L unit lower triangular, no square roots), and
+/// the solves use L; no inverse is formed. Either way S counts as positive
+/// definite only when every pivot is above round-off:
+/// \f$ L_{ii}^2 > n\,\epsilon\,S_{ii} \f$ (2x2:
+/// \f$ \det S > 2 \epsilon S_{00} S_{11} \f$), which is invariant to the
+/// units of each component, so an indefinite or (numerically) singular S is
+/// refused instead of producing a huge gain.
+
+#include <Eigen/Core>
+#include <limits>
+#include <type_traits>
+
+namespace posefuse::detail {
+
+/// The positive-definiteness test and the solves with an innovation
+/// covariance S (see the file comment). Sizes 1 and 2 keep S⁻¹ in closed
+/// form; larger sizes keep the factors of S = L D Lᵀ and never form S⁻¹.
+template <class Mat, int N = Mat::RowsAtCompileTime>
+class SpdSolver {
+  using T = typename Mat::Scalar;
+  using Vec = Eigen::Matrix<T, N, 1>;
+
+ public:
+  /// Factorises S. @return false (solver unusable) unless S is positive definite
+  [[nodiscard, gnu::always_inline]] bool compute(const Mat& S) {
+    if constexpr (N == 1) {
+      if (!(S(0, 0) > T(0))) return false;
+      recip_ = T(1) / S(0, 0);
+      inv_(0, 0) = recip_;
+      return true;
+    } else if constexpr (N == 2) {
+      const T det = S(0, 0) * S(1, 1) - S(0, 1) * S(1, 0);
+      if (!(S(0, 0) > T(0) && det > T(2) * std::numeric_limits<T>::epsilon() * S(0, 0) * S(1, 1)))
+        return false;
+      const T r = T(1) / det;
+      recip_ = r;
+      inv_(0, 0) = S(1, 1) * r;
+      inv_(1, 1) = S(0, 0) * r;
+      inv_(0, 1) = -S(0, 1) * r;
+      inv_(1, 0) = -S(1, 0) * r;
+      return true;
+    } else {
+      // S = L D L^T (L unit lower triangular), column by column, from the
+      // lower triangle of S; no square roots, 1 / d_j kept so that the
+      // solves below multiply. d_j is the squared Cholesky pivot L_jj^2.
+      const T tol = T(N) * std::numeric_limits<T>::epsilon();
+      for (int j = 0; j < N; ++j) {
+        T d = S(j, j);
+        for (int k = 0; k < j; ++k) d -= L_(j, k) * LD_(j, k);
+        // The pivot criterion of the file comment (NaN fails).
+        if (!(d > tol * S(j, j))) return false;
+        inv_diag_(j) = T(1) / d;
+        for (int i = j + 1; i < N; ++i) {
+          T v = S(i, j);
+          for (int k = 0; k < j; ++k) v -= L_(i, k) * LD_(j, k);
+          LD_(i, j) = v;                    // L_ij d_j
+          L_(i, j) = v * inv_diag_(j);
+        }
+      }
+      return true;
+    }
+  }
+  /// Sizes 1 and 2: sets the state compute() leaves for a positive definite
+  /// S, from \f$ S^{-1} \f$ and \f$ 1 / \det S \f$ computed as compute() does.
+  void set_closed_form(const T (&inv)[N][N], T recip) noexcept
+    requires(N <= 2)
+  {
+    for (int i = 0; i < N; ++i)
+      for (int j = 0; j < N; ++j) inv_(i, j) = inv[i][j];
+    recip_ = recip;
+  }
+  /// Sizes 1 and 2: \f$ 1 / \det S \f$ (S⁻¹ = adj(S) / det S), after compute().
+  [[nodiscard]] T recip_det() const noexcept
+    requires(N <= 2)
+  {
+    return recip_;
+  }
+  /// \f$ r^\top S^{-1} r = \sum_j y_j^2 / d_j,\; y = L^{-1} r \f$.
+  [[nodiscard, gnu::always_inline]] T nis(const Vec& r) const {
+    if constexpr (N == 1) {
+      return r(0) * (inv_(0, 0) * r(0));
+    } else if constexpr (N == 2) {
+      return r(0) * (inv_(0, 0) * r(0) + inv_(0, 1) * r(1)) +
+             r(1) * (inv_(1, 0) * r(0) + inv_(1, 1) * r(1));
+    } else {
+      Vec y;
+      T sum = T(0);
+      for (int j = 0; j < N; ++j) {
+        T v = r(j);
+        for (int k = 0; k < j; ++k) v -= L_(j, k) * y(k);
+        y(j) = v;
+        sum += v * v * inv_diag_(j);
+      }
+      return sum;
+    }
+  }
+  /// \f$ A S^{-1} \f$ for an M x N matrix A (rows solved with L, then L^T).
+  template <int M>
+  [[nodiscard, gnu::always_inline]] Eigen::Matrix<T, M, N> right_solve(
+      const Eigen::Matrix<T, M, N>& A) const {
+    if constexpr (N <= 2) {
+      return A * inv_;
+    } else {
+      // X S = A  <=>  (X L D) L^T = A: Y L^T = A forward, Y D^-1, then
+      // X L = Y D^-1 backward (L unit lower triangular).
+      Eigen::Matrix<T, M, N> X;
+      for (int j = 0; j < N; ++j) {
+        Eigen::Matrix<T, M, 1> v = A.col(j);
+        for (int k = 0; k < j; ++k) v -= L_(j, k) * X.col(k);
+        X.col(j) = v;
+      }
+      for (int j = N - 1; j >= 0; --j) {
+        Eigen::Matrix<T, M, 1> v = X.col(j) * inv_diag_(j);
+        for (int k = j + 1; k < N; ++k) v -= L_(k, j) * X.col(k);
+        X.col(j) = v;
+      }
+      return X;
+    }
+  }
+
+ private:
+  struct Empty {};
+  using Inverse = std::conditional_t<(N <= 2), Mat, Empty>;
+  static Inverse zero_inverse() {
+    if constexpr (N <= 2) {
+      return Mat::Zero();
+    } else {
+      return Empty{};
+    }
+  }
+  using Factor = std::conditional_t<(N <= 2), Empty, Mat>;
+  using InvDiag = std::conditional_t<(N <= 2), Empty, Vec>;
+  static Factor zero_factor() {
+    if constexpr (N <= 2) {
+      return Empty{};
+    } else {
+      return Mat::Zero();
+    }
+  }
+  static InvDiag zero_inv_diag() {
+    if constexpr (N <= 2) {
+      return Empty{};
+    } else {
+      return Vec::Zero();
+    }
+  }
+  [[no_unique_address]] Inverse inv_ = zero_inverse();
+  T recip_ = T(0);  // 1 / det S (sizes 1 and 2)
+  [[no_unique_address]] Factor L_ = zero_factor();   // unit lower triangular L
+  [[no_unique_address]] Factor LD_ = zero_factor();  // L_ij d_j (i > j)
+  [[no_unique_address]] InvDiag inv_diag_ = zero_inv_diag();
+};
+
+}  // namespace posefuse::detail

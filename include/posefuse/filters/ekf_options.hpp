@@ -1,0 +1,77 @@
+#pragma once
+/// @file
+/// The compile-time options of posefuse::BasicEkf (filters/ekf.hpp): how the
+/// posterior covariance is formed, when the NIS is computed, whether the
+/// prediction Jacobian is kept for a smoother, and the steady-state gain
+/// memo. EkfOptions holds the defaults; a caller derives from it and hides
+/// the members it changes.
+
+#include <concepts>
+#include <cstdint>
+
+namespace posefuse {
+
+/// How an Ekf forms the posterior covariance (EkfOptions::kCovarianceUpdate).
+enum class CovarianceUpdate : std::uint8_t {
+  /// Joseph's form \f$ (I - K H) P (I - K H)^\top + K R K^\top \f$ (Bucy &
+  /// Joseph 1968; Grewal & Andrews, *Kalman Filtering*, 4th ed., eq. 4.23):
+  /// PSD for any gain, so round-off in K does not make P indefinite. The
+  /// default. Cost over kStandard: one Dim x Dim x M product more (one
+  /// triangle of it), e.g. +20 multiplications for Dim 4, M 2. For a
+  /// selection H with one or two rows it is evaluated expanded, \f$ P - K H P
+  /// - P H^\top K^\top + K S K^\top \f$ (equal for a symmetric P; see
+  /// small_selection_step).
+  kJoseph,
+  /// The textbook \f$ (I - K H) P \f$ (one triangle, mirrored): fewer
+  /// flops; exact only for the optimal gain, so round-off can leave P
+  /// indefinite on ill-conditioned problems (the filter then refuses the
+  /// step with kNotPositiveDefinite rather than store it).
+  kStandard,
+};
+
+/// When an Ekf computes the NIS \f$ r^\top S^{-1} r \f$ of an update
+/// (EkfOptions::kNis).
+enum class NisPolicy : std::uint8_t {
+  kAlways,     ///< every update: UpdateResult::nis is always set (the default)
+  kWhenGated,  ///< only when a NIS gate is finite or a gate functor takes the
+               ///< NIS; otherwise UpdateResult::nis stays NaN (saves one solve with S)
+};
+
+/// Compile-time options of BasicEkf. Derive from it and hide the members you
+/// change; the defaults are the safe choices, and `Ekf<Motion, Sensors...>`
+/// is BasicEkf with these defaults:
+/// ```cpp
+/// struct FastOptions : posefuse::EkfOptions {
+///   static constexpr auto kNis = posefuse::NisPolicy::kWhenGated;
+///   static constexpr bool kRecordJacobian = false;  // no smoother reads last_jacobian()
+/// };
+/// posefuse::BasicEkf<FastOptions, Motion, Sensor> ekf(motion, sensor);
+/// ```
+struct EkfOptions {
+  /// Posterior covariance form (Joseph by default; see CovarianceUpdate).
+  static constexpr CovarianceUpdate kCovarianceUpdate = CovarianceUpdate::kJoseph;
+  /// NIS computation (always by default; see NisPolicy).
+  static constexpr NisPolicy kNis = NisPolicy::kAlways;
+  /// Keep the state Jacobian F of the last applied prediction for
+  /// last_jacobian() (RTS smoothing). Cost: one Dim x Dim copy per predict,
+  /// plus a `jacobian()` call for models that propagate the covariance
+  /// themselves (HasPropagate). Off: last_jacobian() does not compile.
+  static constexpr bool kRecordJacobian = true;
+  /// Steady-state gain memo for time-invariant models (kTimeInvariant):
+  /// keep the covariance half of the update and reuse it, bit for bit,
+  /// while P repeats (kept once the same P has been seen twice in a row).
+  /// Cost: one Dim x Dim comparison per update and, per model, a Dim x Dim
+  /// copy of P whenever P changed; the gain is copied once per new steady state.
+  static constexpr bool kGainMemo = true;
+};
+
+/// A type usable as BasicEkf's options (see EkfOptions).
+template <class O>
+concept EkfOptionSet = requires {
+  { O::kCovarianceUpdate } -> std::convertible_to<CovarianceUpdate>;
+  { O::kNis } -> std::convertible_to<NisPolicy>;
+  { O::kRecordJacobian } -> std::convertible_to<bool>;
+  { O::kGainMemo } -> std::convertible_to<bool>;
+};
+
+}  // namespace posefuse
