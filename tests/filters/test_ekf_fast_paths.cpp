@@ -497,8 +497,8 @@ TEST_CASE("Ekf fast paths: the expanded Joseph form of one- and two-row selectio
           "[filters][ekf][fast][psd]") {
   // Priors with eigenvalues down to 1e-14 of the largest (rescaled rows and
   // columns), measurement noise from 1e-12 to 1 of the prior's scale: the
-  // fast path (filters/ekf.hpp, small_selection_step) against the generic
-  // dense path. Every applied step must hold a PSD covariance, the fast path
+  // closed-form path (filters/detail/ekf_update.hpp,
+  // closed_form_selection_gain) against the generic dense path. Every applied step must hold a PSD covariance, the fast path
   // must apply every step the dense path applies, and where both apply and
   // the problem is well-conditioned they agree to 1e-12.
   std::mt19937 rng(97);

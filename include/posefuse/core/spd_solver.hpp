@@ -20,9 +20,10 @@
 
 namespace posefuse::detail {
 
-/// The positive-definiteness test and the solves with an innovation
-/// covariance S (see the file comment). Sizes 1 and 2 keep S⁻¹ in closed
-/// form; larger sizes keep the factors of S = L D Lᵀ and never form S⁻¹.
+/// The positive-definiteness test and the solves with a symmetric N x N
+/// matrix S (see the file comment). Sizes 1 and 2 keep S⁻¹ and
+/// \f$ 1 / \det S \f$ in closed form; larger sizes keep the factors of
+/// S = L D Lᵀ and never form S⁻¹.
 template <class Mat, int N = Mat::RowsAtCompileTime>
 class SpdSolver {
   using T = typename Mat::Scalar;
@@ -61,29 +62,22 @@ class SpdSolver {
         for (int i = j + 1; i < N; ++i) {
           T v = S(i, j);
           for (int k = 0; k < j; ++k) v -= L_(i, k) * LD_(j, k);
-          LD_(i, j) = v;                    // L_ij d_j
+          LD_(i, j) = v;  // L_ij d_j
           L_(i, j) = v * inv_diag_(j);
         }
       }
       return true;
     }
   }
-  /// Sizes 1 and 2: sets the state compute() leaves for a positive definite
-  /// S, from \f$ S^{-1} \f$ and \f$ 1 / \det S \f$ computed as compute() does.
-  void set_closed_form(const T (&inv)[N][N], T recip) noexcept
-    requires(N <= 2)
-  {
-    for (int i = 0; i < N; ++i)
-      for (int j = 0; j < N; ++j) inv_(i, j) = inv[i][j];
-    recip_ = recip;
-  }
-  /// Sizes 1 and 2: \f$ 1 / \det S \f$ (S⁻¹ = adj(S) / det S), after compute().
-  [[nodiscard]] T recip_det() const noexcept
+  /// Sizes 1 and 2: \f$ 1 / \det S \f$ (S⁻¹ = adj(S) / det S), after a
+  /// successful compute(). A caller that forms products with adj(S) itself
+  /// scales them by this once.
+  [[nodiscard, gnu::always_inline]] T recip_det() const noexcept
     requires(N <= 2)
   {
     return recip_;
   }
-  /// \f$ r^\top S^{-1} r = \sum_j y_j^2 / d_j,\; y = L^{-1} r \f$.
+  /// \f$ r^\top S^{-1} r \f$; beyond 2x2 \f$ \sum_j y_j^2 / d_j,\; y = L^{-1} r \f$.
   [[nodiscard, gnu::always_inline]] T nis(const Vec& r) const {
     if constexpr (N == 1) {
       return r(0) * (inv_(0, 0) * r(0));
@@ -102,7 +96,8 @@ class SpdSolver {
       return sum;
     }
   }
-  /// \f$ A S^{-1} \f$ for an M x N matrix A (rows solved with L, then L^T).
+  /// \f$ A S^{-1} \f$ for an M x N matrix A (beyond 2x2: rows solved with L,
+  /// then with Lᵀ).
   template <int M>
   [[nodiscard, gnu::always_inline]] Eigen::Matrix<T, M, N> right_solve(
       const Eigen::Matrix<T, M, N>& A) const {
@@ -127,36 +122,28 @@ class SpdSolver {
   }
 
  private:
+  static constexpr bool kClosedForm = N <= 2;
   struct Empty {};
-  using Inverse = std::conditional_t<(N <= 2), Mat, Empty>;
-  static Inverse zero_inverse() {
-    if constexpr (N <= 2) {
-      return Mat::Zero();
-    } else {
+  // Members of the other size class are Empty and take no space.
+  using Inverse = std::conditional_t<kClosedForm, Mat, Empty>;
+  using Factor = std::conditional_t<kClosedForm, Empty, Mat>;
+  using InvDiag = std::conditional_t<kClosedForm, Empty, Vec>;
+  using Recip = std::conditional_t<kClosedForm, T, Empty>;
+  template <class Member>
+  static Member zero() {
+    if constexpr (std::is_same_v<Member, Empty>) {
       return Empty{};
+    } else if constexpr (std::is_arithmetic_v<Member>) {
+      return Member(0);
+    } else {
+      return Member::Zero();
     }
   }
-  using Factor = std::conditional_t<(N <= 2), Empty, Mat>;
-  using InvDiag = std::conditional_t<(N <= 2), Empty, Vec>;
-  static Factor zero_factor() {
-    if constexpr (N <= 2) {
-      return Empty{};
-    } else {
-      return Mat::Zero();
-    }
-  }
-  static InvDiag zero_inv_diag() {
-    if constexpr (N <= 2) {
-      return Empty{};
-    } else {
-      return Vec::Zero();
-    }
-  }
-  [[no_unique_address]] Inverse inv_ = zero_inverse();
-  T recip_ = T(0);  // 1 / det S (sizes 1 and 2)
-  [[no_unique_address]] Factor L_ = zero_factor();   // unit lower triangular L
-  [[no_unique_address]] Factor LD_ = zero_factor();  // L_ij d_j (i > j)
-  [[no_unique_address]] InvDiag inv_diag_ = zero_inv_diag();
+  [[no_unique_address]] Inverse inv_ = zero<Inverse>();     // S^-1 (sizes 1 and 2)
+  [[no_unique_address]] Recip recip_ = zero<Recip>();       // 1 / det S (sizes 1 and 2)
+  [[no_unique_address]] Factor L_ = zero<Factor>();         // unit lower triangular L
+  [[no_unique_address]] Factor LD_ = zero<Factor>();        // L_ij d_j (i > j)
+  [[no_unique_address]] InvDiag inv_diag_ = zero<InvDiag>();  // 1 / d_j
 };
 
 }  // namespace posefuse::detail

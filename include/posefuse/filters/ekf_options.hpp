@@ -20,7 +20,7 @@ enum class CovarianceUpdate : std::uint8_t {
   /// triangle of it), e.g. +20 multiplications for Dim 4, M 2. For a
   /// selection H with one or two rows it is evaluated expanded, \f$ P - K H P
   /// - P H^\top K^\top + K S K^\top \f$ (equal for a symmetric P; see
-  /// small_selection_step).
+  /// detail::closed_form_selection_gain in filters/detail/ekf_update.hpp).
   kJoseph,
   /// The textbook \f$ (I - K H) P \f$ (one triangle, mirrored): fewer
   /// flops; exact only for the optimal gain, so round-off can leave P
