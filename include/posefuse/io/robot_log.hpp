@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The recorded-log folder of seed 001's corridor experiment (issue 3, item 7):
+/// The recorded-log folder of seed 001's corridor experiment (docs/programs.md):
 /// reader and writer with file:line errors. The rows become the library's raw
 /// samples (core/samples.hpp): WheelSample, ImuSample, SlamSample and, for
 /// ground truth, PlanarPoseSample.
