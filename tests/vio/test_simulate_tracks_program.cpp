@@ -106,10 +106,14 @@ TEST_CASE("simulate_tracks: semi-real V1_01_easy tracks", "[vio][cli][data]") {
                     dir);
   REQUIRE(r.status == 0);
   const Json j = Json::parse(r.out);
-  // docs/feature-tracks.md quotes these figures.
+  // docs/feature-tracks.md quotes these figures (g++ 12 -O2). Another
+  // compiler may round a border pixel differently and shift the later draws
+  // (clang 14 + sanitizers: 0.0497), so the fraction is checked against the
+  // configured 5 %, within 4.5 standard deviations of a binomial estimate
+  // over 433 856 observations (sigma 3.3e-4).
   CHECK(j["frames"].number() == 2895);
-  CHECK(j["features_per_frame"].number() == Approx(149.86).margin(0.01));
-  CHECK(j["wrong_association_fraction"].number() == Approx(0.0502).margin(1e-4));
+  CHECK(j["features_per_frame"].number() == Approx(149.86).margin(0.05));
+  CHECK(j["wrong_association_fraction"].number() == Approx(0.05).margin(0.0015));
   const posefuse::FeatureTracks t =
       posefuse::read_feature_tracks(out, posefuse::read_euroc_camera(d / "cam0_sensor.yaml"));
   CHECK(t.size() == 2895);

@@ -42,7 +42,9 @@
 /// **Determinism.** One mt19937_64 seeded with `seed`, with its own uniform
 /// and Box-Muller normal (no std::normal_distribution), draws in a fixed
 /// order: a seed gives the same tracks, bit for bit, with every standard
-/// library.
+/// library for one compiler and one set of flags. Another compiler may round
+/// a product differently, move a border pixel in or out of the image and so
+/// shift every later draw; the statistics do not change.
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
