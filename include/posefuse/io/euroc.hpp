@@ -21,7 +21,11 @@
 /// skipped; line numbers in errors are the file's physical, 1-based lines
 /// (posefuse::io_error, `file:line: reason`). Fields are separated by commas
 /// (spaces around them are allowed). A stamp must be a decimal integer that
-/// fits int64; every other field a finite number. Stamps must increase
+/// fits int64; every other field a finite number. IMU readings and the
+/// ground truth's biases must lie within physical bounds: an angular rate
+/// within kMaxAbsAngularRate (1e4 rad/s) and a specific force within
+/// kMaxAbsSpecificForce (1e7 m/s²) per axis; positions within
+/// kMaxAbsPosition (1e100 m), as for every trajectory reader. Stamps must increase
 /// strictly: a repeated or earlier stamp is an error naming both lines
 /// (the ground-truth reader can keep the first or last of repeated stamps
 /// instead, see ReadOptions::duplicates). A
@@ -31,6 +35,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <charconv>
+#include <cstdio>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -70,7 +75,42 @@ struct EurocGroundTruth {
   [[nodiscard]] bool has_velocity_and_biases() const noexcept { return velocity.has_value(); }
 };
 
+/// Largest accepted magnitude (rad/s) of an angular rate (a gyroscope
+/// reading or bias axis) in a EuRoC file: about 1 600 revolutions per
+/// second, far beyond the range of any gyroscope (MEMS parts saturate near
+/// 35 rad/s). Larger values are corrupt, and their products in
+/// pre-integration overflow.
+inline constexpr double kMaxAbsAngularRate = 1e4;
+
+/// Largest accepted magnitude (m/s²) of a specific force (an accelerometer
+/// reading or bias axis) in a EuRoC file: about 1e6 g, beyond shock
+/// accelerometers (near 1e5 g). Larger values are corrupt, and their
+/// products in pre-integration overflow.
+inline constexpr double kMaxAbsSpecificForce = 1e7;
+
 namespace detail::euroc_io {
+
+/// Refuses a vector of `what` (unit `unit`) with an axis beyond `bound`
+/// (file:line).
+template <class Lazy = void>
+void check_bound(const Eigen::Vector3d& v, double bound, const char* what, const char* unit,
+                 const std::filesystem::path& file, std::size_t line) {
+  const double m = v.cwiseAbs().maxCoeff();
+  if (m <= bound) return;
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "%s of magnitude %g %s is beyond the physical bound %g %s", what, m,
+                unit, bound, unit);
+  throw io_error(file, line, buf);
+}
+
+/// Refuses an angular rate beyond kMaxAbsAngularRate and a specific force
+/// beyond kMaxAbsSpecificForce (file:line).
+template <class Lazy = void>
+void check_imu_bounds(const Eigen::Vector3d& gyro, const Eigen::Vector3d& accel, const char* gyro_what,
+                      const char* accel_what, const std::filesystem::path& file, std::size_t line) {
+  check_bound(gyro, kMaxAbsAngularRate, gyro_what, "rad/s", file, line);
+  check_bound(accel, kMaxAbsSpecificForce, accel_what, "m/s^2", file, line);
+}
 
 /// Splits a csv line at commas, trimming spaces and tabs around each field.
 template <class Lazy = void>
@@ -140,9 +180,10 @@ void check_order(std::int64_t t_ns, std::int64_t previous, std::size_t previous_
 /// @return the samples in file order, stamps strictly increasing
 /// @throws posefuse::io_error (file:line) when the file cannot be opened or
 ///         read, a line has not 7 fields, a stamp is not an int64 integer, a
-///         number is unparsable or not finite, a stamp repeats or goes back,
-///         a line is longer than kMaxLineBytes; (file only) when it has no
-///         data line
+///         number is unparsable or not finite, an angular rate is beyond
+///         kMaxAbsAngularRate or a specific force beyond
+///         kMaxAbsSpecificForce, a stamp repeats or goes back, a line is
+///         longer than kMaxLineBytes; (file only) when it has no data line
 template <class Lazy = void>
 [[nodiscard]] std::vector<ImuSample> read_euroc_imu(const std::filesystem::path& file) {
   detail::LineReader reader(file);
@@ -159,6 +200,8 @@ template <class Lazy = void>
     if (!out.empty()) detail::euroc_io::check_order(s.t_ns, out.back().t_ns, previous_line, file, n);
     s.gyro_radps = Eigen::Vector3d(v[0], v[1], v[2]);
     s.accel_mps2 = Eigen::Vector3d(v[3], v[4], v[5]);
+    detail::euroc_io::check_imu_bounds(s.gyro_radps, s.accel_mps2, "angular rate", "specific force",
+                                       file, n);
     out.push_back(s);
     previous_line = n;
   }
@@ -176,8 +219,9 @@ template <class Lazy = void>
 /// @throws posefuse::io_error (file:line) when the file cannot be opened or
 ///         read, the first data line has neither 8 nor 17 fields or a later
 ///         one differs from it, a stamp is not an int64 integer, a number is
-///         unparsable or not finite, a quaternion is zero or not unit within
-///         tolerance, a stamp repeats or goes back, a line is too long;
+///         unparsable or not finite, a position is beyond kMaxAbsPosition, a
+///         bias beyond kMaxAbsAngularRate / kMaxAbsSpecificForce, a
+///         quaternion is zero or not unit within tolerance, a stamp repeats or goes back, a line is too long;
 ///         (file only) when it has no data line
 template <class Lazy = void>
 [[nodiscard]] EurocGroundTruth read_euroc_groundtruth(const std::filesystem::path& file,
@@ -216,6 +260,10 @@ template <class Lazy = void>
     T.linear() = q.toRotationMatrix();
     T.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
     detail::traj_io::check_position(T.translation(), file, n);
+    if (columns == 17)
+      detail::euroc_io::check_imu_bounds(Eigen::Vector3d(v[10], v[11], v[12]),
+                                         Eigen::Vector3d(v[13], v[14], v[15]), "gyroscope bias",
+                                         "accelerometer bias", file, n);
     const detail::traj_io::StampAction action =
         gt.t_ns.empty() ? detail::traj_io::StampAction::kAppend
                         : detail::traj_io::next_stamp_action(t_ns, gt.t_ns.back(), previous_line,
