@@ -36,8 +36,8 @@
 // in the wrong frame; the gated fuser completes the loop; the seed's fuser
 // follows odometry once SLAM is lost and, averaging raw angles near ±180°,
 // once reports a heading 180° off ("all poses"). Doubts about a log (see
-// posefuse/io/robot_log_checks.hpp) are printed as "warning:" lines and in
-// --json under "warnings".
+// posefuse/io/robot_log_checks.hpp) are printed as "warning:" lines on
+// standard error and, with --json, listed under "warnings".
 
 #include <cmath>
 #include <cstdint>
@@ -139,8 +139,6 @@ void print_table(const posefuse::CorridorRunResult& r, const std::string& source
               num(gf, 2).c_str(), gf < od ? "better" : "NOT better", num(od, 2).c_str());
   std::printf("Seed fuser: ends %s m from the start — %s than odometry alone.\n", num(sf, 2).c_str(),
               sf < od ? "better" : "worse or no better");
-  if (!r.warnings.empty()) std::printf("\n");
-  for (const auto& w : r.warnings) std::printf("warning: %s\n", w.c_str());
 }
 
 /// The figures as JSON (numbers round-trip; a figure that does not exist is null).
@@ -217,6 +215,9 @@ int run(const Options& o) {
   files.commit();
   if (o.json) print_json(r, source);
   else print_table(r, source);
+  // Doubts about the log go to standard error (stdout stays the report).
+  std::fflush(stdout);
+  for (const auto& w : r.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   return 0;
 }
 

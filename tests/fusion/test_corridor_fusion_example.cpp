@@ -217,6 +217,11 @@ TEST_CASE("corridor_fusion: --json reports warnings, tilted SLAM poses and the m
   CHECK(json.out.find("\"magnetometer_calibrated\": false") != std::string::npos);
   const auto table = posefuse::test::run(exe, "--log '" + log.string() + "'", dir);
   REQUIRE(table.status == 0);
-  CHECK(table.out.find("warning: ") != std::string::npos);
-  CHECK(table.out.find("ground truth in the odometry frame") != std::string::npos);
+  // Warnings go to standard error, one `warning:` line each; the table on
+  // standard output has none.
+  CHECK(table.err.find("warning: ") == 0);
+  CHECK(table.err.find("groundtruth.csv: the first pose is (2.00 m") != std::string::npos);
+  CHECK(table.out.find("warning: ") == std::string::npos);
+  CHECK(json.err.find("warning: ") == 0);
+  CHECK(table.err.find("ground truth in the odometry frame") != std::string::npos);
 }
