@@ -37,6 +37,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 #include <apps/cli.hpp>
@@ -204,6 +205,59 @@ void check_magnitudes(const G2oGraph2d& g, const std::filesystem::path& file) {
   }
 }
 
+/// Refuses a graph whose information leaves a node free (its pose would be
+/// whatever the start is), naming the node's VERTEX_SE2 line: a node tied
+/// to the fixed nodes only through edges of zero information, or one whose
+/// edges all have zero heading (theta-theta) or zero position (x, y)
+/// information. The same graph is refused from every start.
+void check_nodes_are_fixed(const G2oGraph2d& g, const std::filesystem::path& file) {
+  const std::size_t n = g.vertices.size();
+  std::unordered_map<std::int64_t, std::size_t> index;
+  index.reserve(n);
+  for (std::size_t k = 0; k < n; ++k) index.emplace(g.vertices[k].id, k);
+  std::vector<std::size_t> parent(n);
+  for (std::size_t k = 0; k < n; ++k) parent[k] = k;
+  const auto find = [&parent](std::size_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  std::vector<double> heading(n, 0.0), position(n, 0.0);
+  for (const G2oEdgeSE2& e : g.edges) {
+    const std::size_t a = index.at(e.from), b = index.at(e.to);
+    const Eigen::Matrix3d& I = e.information;
+    if (I.cwiseAbs().maxCoeff() > 0) parent[find(a)] = find(b);
+    for (const std::size_t k : {a, b}) {
+      heading[k] += I(2, 2);
+      position[k] += I(0, 0) + I(1, 1);
+    }
+  }
+  std::vector<char> fixed(n, 0);
+  if (g.fixed.empty() && n > 0) fixed[0] = 1;
+  for (const std::int64_t id : g.fixed) fixed[index.at(id)] = 1;
+  std::vector<char> anchored(n, 0);
+  for (std::size_t k = 0; k < n; ++k)
+    if (fixed[k]) anchored[find(k)] = 1;
+  const auto refuse = [&](std::size_t k, const std::string& why) {
+    throw io_error(file, g.vertices[k].line,
+                   "node " + std::to_string(g.vertices[k].id) + " " + why +
+                       ", so the information does not determine its pose and the answer would depend on the start");
+  };
+  for (std::size_t k = 0; k < n; ++k) {
+    if (fixed[k]) continue;
+    if (!anchored[find(k)]) refuse(k, "is tied to the fixed node only through edges of zero information");
+    if (heading[k] == 0) refuse(k, "has no heading information (every edge at it has a zero theta-theta entry)");
+    if (position[k] == 0) refuse(k, "has no position information (every edge at it has zero x and y entries)");
+  }
+}
+
+/// The sentence for a graph whose information does not fix every node
+/// (the rotation-first systems are singular), from any start.
+[[noreturn]] void refuse_unfixed(const std::string& name) {
+  throw apps::data_error(name +
+                         ": the information does not fix every node (rank-deficient information leaves "
+                         "a heading or position free), so the answer would depend on the start");
+}
+
 int run(const Options& o) {
   G2oGraph2d file_graph;
   PoseGraph4Dof graph;
@@ -211,6 +265,7 @@ int run(const Options& o) {
   if (o.input) {
     file_graph = read_g2o_2d(*o.input);
     check_magnitudes(file_graph, *o.input);
+    check_nodes_are_fixed(file_graph, *o.input);
     name = o.input->filename().string();
     try {
       graph = pose_graph_from_g2o(file_graph, o.loss);
@@ -235,11 +290,25 @@ int run(const Options& o) {
   const auto t0 = std::chrono::steady_clock::now();
   try {
     graph.validate();
-    if (o.rotation_first) graph.initialize_rotation_first();
   } catch (const posefuse::invalid_argument& e) {
     throw apps::data_error(name + ": " + e.what());
   }
-  const double init_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  // The rotation-first systems are solvable exactly when the information
+  // fixes every heading and position; from the file's poses the same check
+  // runs on a copy of them, which are then put back.
+  const std::vector<Pose4Dof> file_poses = o.rotation_first ? std::vector<Pose4Dof>() : graph.poses();
+  try {
+    graph.initialize_rotation_first();
+  } catch (const posefuse::invalid_argument& e) {
+    if (std::string_view(e.what()).find("singular") == std::string_view::npos)
+      throw apps::data_error(name + ": " + e.what());
+    refuse_unfixed(o.input ? o.input->string() : name);
+  }
+  if (!o.rotation_first)
+    for (std::size_t k = 0; k < file_poses.size(); ++k) graph.set_pose(graph.ids()[k], file_poses[k]);
+  // From the file's poses nothing was initialised: the check is not timed.
+  const double init_time =
+      o.rotation_first ? std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() : 0.0;
   const double init_cost = graph.cost();
   const PoseGraphSummary s = graph.optimize(o.solver);
   const double solve_time = init_time + s.solve_time_s;

@@ -131,6 +131,13 @@ TEST_CASE("Programs keep the exit-status and one-line contract on bad input", "[
   const std::string vertices = "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\n";
   (void)dir.write("huge.g2o", vertices + "EDGE_SE2 0 1 1e308 0 0 1 0 0 1 0 1\n");
   (void)dir.write("strong.g2o", vertices + "EDGE_SE2 0 1 1 0 0 1e300 0 0 1e300 0 1e300\n");
+  // Node 2 (line 3) tied by an edge of zero information, by one without
+  // position information, and by one without information on y: refused
+  // from the default start and from the file's poses alike.
+  const std::string three = vertices + "VERTEX_SE2 2 2 0.5 0.1\nEDGE_SE2 0 1 1 0 0 100 0 0 100 0 100\n";
+  (void)dir.write("zero_info.g2o", three + "EDGE_SE2 1 2 1 0 0 0 0 0 0 0 0\n");
+  (void)dir.write("heading_only.g2o", three + "EDGE_SE2 1 2 1 0 0 0 0 0 0 0 100\n");
+  (void)dir.write("no_y.g2o", three + "EDGE_SE2 1 2 1 0 0 100 0 0 0 0 100\n");
 
   // EuRoC files: a recording at rest, and one with an accelerometer reading of 1e308 on line 3.
   const RestRecording rest = rest_recording(12.0);
@@ -168,6 +175,22 @@ TEST_CASE("Programs keep the exit-status and one-line contract on bad input", "[
       {"optimize_pose_graph", "--input '{dir}/huge.g2o'", 1, {"{dir}/huge.g2o:3: ", "1e+308"}, {"singular"}},
       {"optimize_pose_graph", "--input '{dir}/strong.g2o'", 1, {"{dir}/strong.g2o:3: ", "1e+300"},
        {"singular", "too weak"}},
+      // A node the information leaves free is refused from every start.
+      {"optimize_pose_graph", "--input '{dir}/zero_info.g2o'", 1,
+       {"{dir}/zero_info.g2o:3: node 2 is tied to the fixed node only through edges of zero information"},
+       {"singular", "initialisation"}},
+      {"optimize_pose_graph", "--input '{dir}/zero_info.g2o' --init file --json", 1,
+       {"{dir}/zero_info.g2o:3: node 2 is tied to the fixed node only through edges of zero information"},
+       {}},
+      {"optimize_pose_graph", "--input '{dir}/heading_only.g2o' --init file", 1,
+       {"{dir}/heading_only.g2o:3: node 2 has no position information"},
+       {}},
+      {"optimize_pose_graph", "--input '{dir}/no_y.g2o'", 1,
+       {"{dir}/no_y.g2o: the information does not fix every node"},
+       {"singular", "initialisation"}},
+      {"optimize_pose_graph", "--input '{dir}/no_y.g2o' --init file", 1,
+       {"{dir}/no_y.g2o: the information does not fix every node"},
+       {}},
       // 7. a folder given as a result
       {"compare_results", "--result '{dir}/folder'", 1, {"{dir}/folder: ", "folder"}, {"basic_filebuf"}},
       // 8. programs without --duplicates do not offer it
@@ -216,6 +239,26 @@ TEST_CASE("Programs keep the exit-status and one-line contract on bad input", "[
   // The refused runs left the inputs as they were.
   CHECK(posefuse::test::slurp(dir.path() / "gt.tum") == tum_loop(200));
   CHECK(posefuse::test::slurp(dir.path() / "est.tum") == tum_loop(200));
+}
+
+TEST_CASE("optimize_pose_graph --init file starts from the file's poses after the fixedness check",
+          "[examples][contract][graph]") {
+  POSEFUSE_REQUIRE_EXAMPLE(exe, "optimize_pose_graph");
+  const TempDir dir("contract-init-file");
+  // A triangle with a loop, poses away from the measurements.
+  const fs::path g = dir.write("loop.g2o",
+                               "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1.3 0.2 1.4\nVERTEX_SE2 2 0.8 1.1 3.0\n"
+                               "EDGE_SE2 0 1 1 0 1.5708 100 0 0 100 0 100\n"
+                               "EDGE_SE2 1 2 1 0 1.5708 100 0 0 100 0 100\n"
+                               "EDGE_SE2 2 0 1.4142 0 -3.1416 10 0 0 10 0 10\n");
+  const Run r = posefuse::test::run(exe, "--input '" + g.string() + "' --init file --json", dir);
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  const auto j = posefuse::test::Json::parse(r.out);
+  // The check ran the rotation-first systems, yet the solve starts from the file.
+  CHECK(j["initial_cost"].number() == j["file_cost"].number());
+  CHECK(j["file_cost"].number() > 1.0);
+  CHECK(j["final_cost"].number() < j["file_cost"].number());
 }
 
 TEST_CASE("ekf_custom_model: --help prints usage only, unwritable output fails",
