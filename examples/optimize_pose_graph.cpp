@@ -215,9 +215,12 @@ void check_nodes_are_fixed(const G2oGraph2d& g, const std::filesystem::path& fil
   std::unordered_map<std::int64_t, std::size_t> index;
   index.reserve(n);
   for (std::size_t k = 0; k < n; ++k) index.emplace(g.vertices[k].id, k);
-  std::vector<std::size_t> parent(n);
-  for (std::size_t k = 0; k < n; ++k) parent[k] = k;
-  const auto find = [&parent](std::size_t x) {
+  // Components through edges of non-zero information (`informed`) and
+  // through any edge (`linked`: a node outside the fixed nodes' one is
+  // disconnected, which PoseGraph4Dof::validate() reports).
+  std::vector<std::size_t> informed(n), linked(n);
+  for (std::size_t k = 0; k < n; ++k) informed[k] = linked[k] = k;
+  const auto find = [](std::vector<std::size_t>& parent, std::size_t x) {
     while (parent[x] != x) x = parent[x] = parent[parent[x]];
     return x;
   };
@@ -225,7 +228,8 @@ void check_nodes_are_fixed(const G2oGraph2d& g, const std::filesystem::path& fil
   for (const G2oEdgeSE2& e : g.edges) {
     const std::size_t a = index.at(e.from), b = index.at(e.to);
     const Eigen::Matrix3d& I = e.information;
-    if (I.cwiseAbs().maxCoeff() > 0) parent[find(a)] = find(b);
+    linked[find(linked, a)] = find(linked, b);
+    if (I.cwiseAbs().maxCoeff() > 0) informed[find(informed, a)] = find(informed, b);
     for (const std::size_t k : {a, b}) {
       heading[k] += I(2, 2);
       position[k] += I(0, 0) + I(1, 1);
@@ -234,17 +238,20 @@ void check_nodes_are_fixed(const G2oGraph2d& g, const std::filesystem::path& fil
   std::vector<char> fixed(n, 0);
   if (g.fixed.empty() && n > 0) fixed[0] = 1;
   for (const std::int64_t id : g.fixed) fixed[index.at(id)] = 1;
-  std::vector<char> anchored(n, 0);
+  std::vector<char> anchored(n, 0), reached(n, 0);
   for (std::size_t k = 0; k < n; ++k)
-    if (fixed[k]) anchored[find(k)] = 1;
+    if (fixed[k]) {
+      anchored[find(informed, k)] = 1;
+      reached[find(linked, k)] = 1;
+    }
   const auto refuse = [&](std::size_t k, const std::string& why) {
     throw io_error(file, g.vertices[k].line,
                    "node " + std::to_string(g.vertices[k].id) + " " + why +
                        ", so the information does not determine its pose and the answer would depend on the start");
   };
   for (std::size_t k = 0; k < n; ++k) {
-    if (fixed[k]) continue;
-    if (!anchored[find(k)]) refuse(k, "is tied to the fixed node only through edges of zero information");
+    if (fixed[k] || !reached[find(linked, k)]) continue;
+    if (!anchored[find(informed, k)]) refuse(k, "is tied to the fixed node only through edges of zero information");
     if (heading[k] == 0) refuse(k, "has no heading information (every edge at it has a zero theta-theta entry)");
     if (position[k] == 0) refuse(k, "has no position information (every edge at it has zero x and y entries)");
   }
