@@ -1,8 +1,10 @@
 // Writes the seed corpora of the fuzz harnesses: make_seed_corpus <dir>
 // creates <dir>/<harness>/<seed> files, a few valid inputs (written with the
-// library's own writers) and edge cases per format. It checks what it
-// writes: every seed named valid_* must be accepted by the reader and every
-// seed named bad_* rejected with posefuse::io_error, so a format change
+// library's own writers, and the programs' JSON writer for compare_results'
+// saved results) and edge cases per format. It checks what it writes: every
+// seed named valid_* must be accepted by the reader and every seed named
+// bad_* rejected with posefuse::io_error (compare_results' reader:
+// posefuse::apps::data_error), so a format change
 // that invalidates the seeds fails the build instead of silently starving
 // the fuzzers. Nothing is copied from the real datasets.
 
@@ -29,6 +31,7 @@
 #include <posefuse/io/robot_log.hpp>
 #include <posefuse/io/tum.hpp>
 
+#include "compare_results_reader.hpp"
 #include "fuzz_support.hpp"
 
 namespace fs = std::filesystem;
@@ -255,6 +258,75 @@ void euroc_seeds(const fs::path& out, const fs::path& tmp) {
   seed("bad_gt_stamp_overflow", imu.str(), "99999999999999999999,0,0,0,1,0,0,0\n");
 }
 
+// --- compare_results' saved results ------------------------------------------
+
+/// A saved result as evaluate_trajectory --save-results writes it (the
+/// members of its summary), through the programs' JSON writer.
+std::string saved_result(bool rpe, bool nees) {
+  std::ostringstream text;
+  posefuse::apps::JsonWriter j(text);
+  j.begin_object();
+  j.member("metric", rpe ? "rpe" : "ape")
+      .member("groundtruth_format", "tum")
+      .member("estimate_format", "tum")
+      .member("formats_detected", true)
+      .member("pose_relation", rpe ? "full" : "trans_part")
+      .member("unit", rpe ? "unit-less" : "m")
+      .member("alignment", "se3")
+      .member("scale", 1.0);
+  if (rpe) j.member("delta", 1.0).member("delta_unit", "frames");
+  j.member("count", std::size_t(1990)).member("rmse", 0.0421).member("mean", 0.0375).member("median", 0.0350);
+  j.member("std", 0.0192).member("min", 0.0011).member("max", 0.1274).member("sse", 3.5271);
+  if (nees) {
+    j.member("nees_mean", 2.87).member("nees_dim", 3).member("nees_lower", 2.81).member("nees_upper", 3.19);
+    j.member("nees_consistent", true);
+  }
+  j.end_object().finish();
+  return text.str();
+}
+
+void compare_results_seeds(const fs::path& out, const fs::path& tmp) {
+  const fs::path dir = out / "fuzz_compare_results";
+  const auto seed = [&](const std::string& name, const std::string& s) {
+    put(dir, name, s);
+    const std::string label = "fuzz_compare_results/" + name;
+    const bool valid = name.rfind("valid_", 0) == 0;
+    std::string why;
+    bool accepted = true;
+    try {
+      posefuse_fuzz::write_bytes(tmp / "r.json", s);
+      (void)posefuse_fuzz::read_saved_result(tmp / "r.json");
+    } catch (const posefuse::apps::data_error& e) {
+      accepted = false;
+      why = e.what();
+    }
+    if (accepted != valid) {
+      std::fprintf(stderr, "make_seed_corpus: seed %s was %s%s%s\n", label.c_str(),
+                   accepted ? "accepted" : "rejected", why.empty() ? "" : ": ", why.c_str());
+      ++g_errors;
+    }
+  };
+  const std::string ape = saved_result(false, false);
+  seed("valid_ape", ape);
+  seed("valid_rpe_with_nees", saved_result(true, true));
+  const std::string head = R"({"metric": "ape", "pose_relation": "trans_part", "alignment": "se3", "unit": "m", )";
+  const std::string stats = R"("mean": 1, "median": 1, "std": 0, "min": 1, "max": 1})";
+  seed("valid_members_only", head + R"("count": 5, "rmse": 1, )" + stats);
+  seed("bad_null_rmse", head + R"("count": 5, "rmse": null, )" + stats);
+  seed("bad_negative_count", head + R"("count": -5, "rmse": 1, )" + stats);
+  seed("bad_fraction_count", head + R"("count": 2.5, "rmse": 1, )" + stats);
+  seed("bad_number_out_of_range", head + R"("count": 5, "rmse": 1e999, )" + stats);
+  seed("bad_duplicate_key", head + R"("count": 5, "count": 6, "rmse": 1, )" + stats);
+  seed("bad_missing_unit", R"({"metric": "ape", "pose_relation": "trans_part", "alignment": "se3", )"
+                           R"("count": 5, "rmse": 1, )" + stats);
+  seed("bad_string_count", head + R"("count": "5", "rmse": 1, )" + stats);
+  seed("bad_trailing_comma", ape.substr(0, ape.rfind('}')) + ",}");
+  seed("bad_array", "[" + ape + "]");
+  seed("bad_deep", std::string(70, '[') + std::string(70, ']'));
+  seed("bad_escape", head.substr(0, head.size() - 2) + R"(, "x": "\ud800"})");
+  seed("bad_empty", "");
+}
+
 // --- robot log ---------------------------------------------------------------
 
 posefuse::RobotLog small_log(bool with_truth) {
@@ -452,6 +524,7 @@ int main(int argc, char** argv) {
   tum_seeds(out, tmp.path());
   g2o_seeds(out, tmp.path());
   euroc_seeds(out, tmp.path());
+  compare_results_seeds(out, tmp.path());
   robot_log_seeds(out, tmp.path());
   ekf_seeds(out);
   if (g_errors > 0) {
