@@ -7,6 +7,7 @@
 /// (graph/edge_error_4dof.hpp, graph/robust_loss.hpp); Ceres reports
 /// \f$ F/2 \f$.
 
+#include <functional>
 #include <string_view>
 
 namespace posefuse {
@@ -32,6 +33,16 @@ enum class Termination {
   return "?";
 }
 
+/// What one iteration of the optimiser did, passed to
+/// PoseGraphOptions::progress.
+struct PoseGraphIteration {
+  int iteration = 0;       ///< linear solves so far, this one included (1-based)
+  double cost = 0.0;       ///< \f$ F \f$ at the state after this iteration
+  double step_norm = 0.0;  ///< \f$ \|\Delta\| \f$ of the step tried (0 when the system could not be solved)
+  double lambda = 0.0;     ///< LM damping \f$ \lambda \f$ of the step (0 for Gauss–Newton)
+  bool accepted = false;   ///< the step lowered the cost and was taken
+};
+
 /// Optimiser settings.
 struct PoseGraphOptions {
   bool levenberg_marquardt = true;    ///< false: undamped Gauss–Newton (stops when a step increases the cost)
@@ -45,6 +56,10 @@ struct PoseGraphOptions {
   /// rounding (the z rows decouple exactly); 1.4-1.5x faster on the real
   /// g2o files (bench_graph BM_G2o/posefuse vs posefuse_4dof).
   bool planar_fast_path = true;
+  /// Called after every iteration when set (e.g. to show progress on a
+  /// terminal); it only observes: the iterations and the result are the
+  /// same with or without it. Empty (the default): one test per iteration.
+  std::function<void(const PoseGraphIteration&)> progress;
 };
 
 /// What an optimisation did.

@@ -10,6 +10,8 @@
 /// (Nielsen, "Damping parameter in Marquardt's method", IMM DTU 1999):
 /// shrunk by \f$ \max(1/3, 1 - (2\rho - 1)^3) \f$ after a step with gain
 /// ratio \f$ \rho \f$, multiplied by a doubling \f$ \nu \f$ after a failed one.
+/// After every iteration PoseGraphOptions::progress, when set, is told the
+/// iteration, the cost, the step norm, λ and whether the step was taken.
 
 #include <Eigen/Core>
 #include <algorithm>
@@ -110,6 +112,13 @@ template <int B>
   double cost_now = s.initial_cost;
   bool relinearise = true;
   s.termination = Termination::kMaxIterations;
+  // Progress: built only when a callback is set (it reads, never writes).
+  double lambda_used = 0.0;
+  const auto report = [&](bool accepted, const Eigen::VectorXd* dx) {
+    if (!options.progress) return;
+    options.progress(PoseGraphIteration{s.iterations, cost_now, dx != nullptr ? dx->norm() : 0.0,
+                                        lambda_used, accepted});
+  };
   while (s.iterations < options.max_iterations) {
     if (relinearise) {
       f.linearize(w.x);
@@ -121,7 +130,9 @@ template <int B>
       relinearise = false;
     }
     ++s.iterations;
+    lambda_used = damping.lambda;
     if (!solve_damped(w, damping.lambda)) {
+      report(false, nullptr);
       if (!damped || !damping.raise()) {
         s.termination = Termination::kNoProgress;
         break;
@@ -145,6 +156,7 @@ template <int B>
       w.x.swap(w.trial);
       ++s.accepted;
       cost_now = std::min(cost_now, cost_new);
+      report(true, &dx);
       s.termination = Termination::kFunctionTolerance;
       break;
     }
@@ -156,6 +168,7 @@ template <int B>
       if (damped) damping.shrink(predicted > 0 ? decrease / predicted : 1.0);
       const double prev = cost_now;
       cost_now = cost_new;
+      report(true, &dx);
       if (decrease < options.function_tolerance * prev) {
         s.termination = Termination::kFunctionTolerance;
         break;
@@ -167,6 +180,7 @@ template <int B>
       continue;
     }
     f.set_trigonometry(w.x);  // back to the current state's
+    report(false, &dx);
     if (!damped) {
       s.termination = Termination::kNoProgress;
       break;
