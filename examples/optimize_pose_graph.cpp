@@ -43,6 +43,7 @@
 #include <apps/cli.hpp>
 #include <apps/json.hpp>
 #include <apps/output_file.hpp>
+#include <apps/progress.hpp>
 #include <posefuse/sim/pose_graph_4dof.hpp>
 #include <posefuse/core/error.hpp>
 #include <posefuse/eval/alignment.hpp>
@@ -266,11 +267,16 @@ void check_nodes_are_fixed(const G2oGraph2d& g, const std::filesystem::path& fil
 }
 
 int run(const Options& o) {
+  // On a terminal, standard error shows the stage and the solver's iterations.
+  apps::TerminalProgress progress("optimize_pose_graph");
   G2oGraph2d file_graph;
   PoseGraph4Dof graph;
   std::string name = "built-in";
   if (o.input) {
+    progress.stage("reading " + o.input->string());
     file_graph = read_g2o_2d(*o.input);
+    progress.stage("checking " + std::to_string(file_graph.vertices.size()) + " vertices, " +
+                   std::to_string(file_graph.edges.size()) + " edges");
     check_magnitudes(file_graph, *o.input);
     check_nodes_are_fixed(file_graph, *o.input);
     name = o.input->filename().string();
@@ -294,6 +300,7 @@ int run(const Options& o) {
       o.groundtruth ? std::optional<std::vector<SE2<double>>>(read_groundtruth(*o.groundtruth)) : std::nullopt;
 
   const double file_cost = graph.cost();
+  progress.stage(o.rotation_first ? "rotation-first initialisation" : "checking the information");
   const auto t0 = std::chrono::steady_clock::now();
   try {
     graph.validate();
@@ -317,7 +324,23 @@ int run(const Options& o) {
   const double init_time =
       o.rotation_first ? std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() : 0.0;
   const double init_cost = graph.cost();
-  const PoseGraphSummary s = graph.optimize(o.solver);
+  PoseGraphOptions solver = o.solver;
+  if (progress.enabled()) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "solving: %zu nodes, %zu edges, cost %.6g", graph.num_nodes(),
+                  graph.num_edges(), init_cost);
+    progress.stage(buf);
+    solver.progress = [&progress, max = o.solver.max_iterations](const PoseGraphIteration& it) {
+      progress.update([&] {
+        char line[160];
+        std::snprintf(line, sizeof line, "iteration %d/%d  cost %.6g  step %.3g%s", it.iteration, max, it.cost,
+                      it.step_norm, it.accepted ? "" : " (rejected)");
+        return std::string(line);
+      });
+    };
+  }
+  const PoseGraphSummary s = graph.optimize(solver);
+  progress.clear();
   const double solve_time = init_time + s.solve_time_s;
   if (!std::isfinite(s.final_cost)) throw apps::data_error(name + ": the final cost is not finite");
   const std::optional<double> rmse =

@@ -45,6 +45,7 @@
 #include <apps/cli.hpp>
 #include <apps/json.hpp>
 #include <apps/output_file.hpp>
+#include <apps/progress.hpp>
 #include <posefuse/sim/pose_graph_4dof.hpp>
 #include <apps/svg.hpp>
 #include <posefuse/eval/alignment.hpp>
@@ -281,6 +282,8 @@ std::string plot(const Trajectory& truth, const Trajectory& before, const Trajec
 }
 
 int run(const Options& o) {
+  // On a terminal, standard error shows the stage and the solver's iterations.
+  apps::TerminalProgress progress("pose_graph_correction");
   Trajectory truth_up, odo_up, odo_in;
   std::vector<Edge4Dof> loops;
   Eigen::Matrix3d A = Eigen::Matrix3d::Identity();
@@ -305,7 +308,9 @@ int run(const Options& o) {
     odo_in = odo_up;
   } else {
     name = o.odometry->filename().string();
+    progress.stage("reading " + o.odometry->string());
     odo_in = read_trajectory(*o.odometry, o.format);
+    progress.stage("reading " + o.groundtruth->string());
     const Trajectory truth_in = read_trajectory(*o.groundtruth, o.format);
     if (truth_in.size() != odo_in.size())
       throw apps::data_error(o.odometry->string() + " has " + std::to_string(odo_in.size()) +
@@ -349,7 +354,22 @@ int run(const Options& o) {
   } catch (const posefuse::invalid_argument& e) {
     throw apps::data_error(name + ": " + e.what());
   }
-  const PoseGraphSummary s = graph.optimize();
+  PoseGraphOptions solver;
+  if (progress.enabled()) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "solving: %zu nodes, %zu edges", graph.num_nodes(), graph.num_edges());
+    progress.stage(buf);
+    solver.progress = [&progress, max = solver.max_iterations](const PoseGraphIteration& it) {
+      progress.update([&] {
+        char line[160];
+        std::snprintf(line, sizeof line, "iteration %d/%d  cost %.6g  step %.3g%s", it.iteration, max, it.cost,
+                      it.step_norm, it.accepted ? "" : " (rejected)");
+        return std::string(line);
+      });
+    };
+  }
+  const PoseGraphSummary s = graph.optimize(solver);
+  progress.clear();
   Trajectory after_up = odo_up;
   for (std::size_t k = 0; k < after_up.size(); ++k) after_up.poses[k] = to_isometry(graph.poses()[k]);
   const Ape before = ape_of(truth_up, odo_up);

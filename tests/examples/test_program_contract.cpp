@@ -261,6 +261,43 @@ TEST_CASE("optimize_pose_graph --init file starts from the file's poses after th
   CHECK(j["final_cost"].number() < j["file_cost"].number());
 }
 
+TEST_CASE("optimize_pose_graph and pose_graph_correction show progress only on a terminal",
+          "[examples][contract][progress]") {
+  const TempDir dir("contract-progress");
+  for (const char* program : {"optimize_pose_graph", "pose_graph_correction"}) {
+    const fs::path exe = posefuse::test::example(program);
+    if (exe.empty()) {
+      WARN("SKIPPED: example '" << program << "' not built");
+      continue;
+    }
+    INFO(program);
+    // Standard error not a terminal (a file): nothing but the result.
+    const Run plain = posefuse::test::run(exe, "--json", dir);
+    REQUIRE(plain.status == 0);
+    CHECK(plain.err.empty());
+    CHECK_NOTHROW(posefuse::test::Json::parse(plain.out));
+    // Standard error a terminal (script(1) runs the program on a pseudo-
+    // terminal; standard output goes to a file): one status line rewritten
+    // in place with the solver's iterations, erased at the end.
+    if (!fs::exists("/usr/bin/script")) {
+      WARN("SKIPPED: /usr/bin/script is not installed");
+      continue;
+    }
+    const fs::path out = dir.path() / "out.json", tty = dir.path() / "tty.txt";
+    const std::string inner = "'" + exe.string() + "' --json 2>&1 >'" + out.string() + "'";
+    const std::string cmd = "/usr/bin/script -qec \"" + inner + "\" /dev/null > '" + tty.string() + "' 2>&1";
+    REQUIRE(std::system(cmd.c_str()) == 0);
+    const std::string shown = posefuse::test::slurp(tty);
+    INFO(shown);
+    CHECK(shown.find(std::string("\r") + program + ": solving: ") != std::string::npos);
+    CHECK(shown.find(std::string("\r") + program + ": iteration 1/100  cost ") != std::string::npos);
+    CHECK(shown.size() >= 4);
+    CHECK(shown.substr(shown.size() - 4) == "\r\033[K");
+    CHECK(shown.find('\n') == std::string::npos);
+    CHECK_NOTHROW(posefuse::test::Json::parse(posefuse::test::slurp(out)));
+  }
+}
+
 TEST_CASE("ekf_custom_model: --help prints usage only, unwritable output fails",
           "[examples][contract][tutorial]") {
   POSEFUSE_REQUIRE_EXAMPLE(exe, "ekf_custom_model");
