@@ -51,6 +51,7 @@
 #include <apps/cli.hpp>
 #include <apps/json.hpp>
 #include <apps/output_file.hpp>
+#include <apps/progress.hpp>
 #include <apps/spooled_input.hpp>
 #include <apps/svg.hpp>
 #include <posefuse/eval/consistency.hpp>
@@ -595,13 +596,20 @@ int run_read(const Options& given, apps::SpooledInputs& spool) {
       given.ref_format_given ? given.groundtruth : spool.readable(given.groundtruth);
   const std::filesystem::path est_path = given.est_format_given ? given.estimate : spool.readable(given.estimate);
   const Options o = resolve_formats(given, ref_path, est_path);
+  // On a terminal, standard error shows the stage (reading, associating, the metric).
+  apps::TerminalProgress progress("evaluate_trajectory");
   std::vector<std::string> warnings;
+  progress.stage("reading " + o.groundtruth.string());
   const posefuse::Trajectory ref_file =
       load(ref_path, o.ref_format, o.times, o.duplicates, false, warnings).trajectory;
+  progress.stage("reading " + o.estimate.string());
   const Loaded est_loaded = load(est_path, o.est_format, o.times, o.duplicates, true, warnings);
   const posefuse::Trajectory& est_file = est_loaded.trajectory;
+  progress.clear();
   for (std::string& w : warnings) w = spool.shown(w);
   for (const std::string& w : warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  progress.stage("associating " + std::to_string(ref_file.size()) + " and " + std::to_string(est_file.size()) +
+                 " poses");
   posefuse::Trajectory ref = thin(ref_file, o);
   const posefuse::Trajectory est = thin(est_file, o);
   posefuse::Trajectory ref_sync, est_sync;
@@ -632,6 +640,8 @@ int run_read(const Options& given, apps::SpooledInputs& spool) {
     throw apps::data_error("--n-to-align " + std::to_string(o.align.n_to_align) + " but only " +
                            std::to_string(ref_sync.size()) + " poses are associated");
   }
+  progress.stage(std::string(o.metric_rpe ? "RPE" : "APE") + " of " + std::to_string(ref_sync.size()) +
+                 " pose pairs");
   posefuse::MetricResult result;
   try {
     result = o.metric_rpe ? posefuse::rpe(ref_sync, est_sync, o.rpe)
@@ -653,6 +663,7 @@ int run_read(const Options& given, apps::SpooledInputs& spool) {
     throw apps::usage_error("NEES (an estimate with covariance) cannot be combined with --project-to-plane");
   const std::optional<posefuse::NeesResult> nees =
       consistency(o, est_loaded, ref_sync, est_sync, result);
+  progress.clear();
   apps::OutputFiles outputs;
   if (o.save_results) outputs.add(*o.save_results, results_json(o, result, nees, ref_sync, warnings));
   if (o.plot) outputs.add(*o.plot, plot_svg(o, result, ref_sync, est_sync));

@@ -298,6 +298,32 @@ TEST_CASE("optimize_pose_graph and pose_graph_correction show progress only on a
   }
 }
 
+TEST_CASE("evaluate_trajectory shows its stages only on a terminal", "[examples][contract][progress]") {
+  POSEFUSE_REQUIRE_EXAMPLE(exe, "evaluate_trajectory");
+  const TempDir dir("contract-progress-eval");
+  const fs::path gt = dir.write("gt.tum", tum_loop(200));
+  const std::string args = "--groundtruth '" + gt.string() + "' --estimate '" + gt.string() + "' --json";
+  const Run plain = posefuse::test::run(exe, args, dir);
+  REQUIRE(plain.status == 0);
+  CHECK(plain.err.empty());
+  if (!fs::exists("/usr/bin/script")) {
+    WARN("SKIPPED: /usr/bin/script is not installed");
+    return;
+  }
+  const fs::path out = dir.path() / "out.json", tty = dir.path() / "tty.txt";
+  const std::string inner = "'" + exe.string() + "' " + args + " 2>&1 >'" + out.string() + "'";
+  const std::string cmd = "/usr/bin/script -qec \"" + inner + "\" /dev/null > '" + tty.string() + "' 2>&1";
+  REQUIRE(std::system(cmd.c_str()) == 0);
+  const std::string shown = posefuse::test::slurp(tty);
+  INFO(shown);
+  CHECK(shown.find("\revaluate_trajectory: reading " + gt.string()) != std::string::npos);
+  CHECK(shown.find("\revaluate_trajectory: APE of 200 pose pairs") != std::string::npos);
+  CHECK(shown.size() >= 4);
+  CHECK(shown.substr(shown.size() - 4) == "\r\033[K");
+  // The result on standard output is the one printed without a terminal.
+  CHECK(posefuse::test::slurp(out) == plain.out);
+}
+
 TEST_CASE("ekf_custom_model: --help prints usage only, unwritable output fails",
           "[examples][contract][tutorial]") {
   POSEFUSE_REQUIRE_EXAMPLE(exe, "ekf_custom_model");
