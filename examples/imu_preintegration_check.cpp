@@ -52,6 +52,7 @@
 #include <apps/cli.hpp>
 #include <apps/json.hpp>
 #include <apps/output_file.hpp>
+#include <apps/progress.hpp>
 #include <apps/svg.hpp>
 #include <posefuse/core/chi_square.hpp>
 #include <posefuse/inertial/preintegration.hpp>
@@ -174,8 +175,13 @@ struct Report {
 };
 
 Report run_check(const Options& o) {
+  // On a terminal, standard error shows the files being read and the windows.
+  apps::TerminalProgress progress("imu_preintegration_check");
+  progress.stage("reading " + o.imu.string());
   const std::vector<posefuse::ImuSample> imu = posefuse::read_euroc_imu(o.imu);
+  progress.stage("reading " + o.groundtruth.string());
   const posefuse::EurocGroundTruth gt = posefuse::read_euroc_groundtruth(o.groundtruth);
+  progress.clear();
   if (!gt.has_velocity_and_biases())
     throw apps::data_error(o.groundtruth.string() +
                            ": needs velocity and biases (17 columns); this file has poses only");
@@ -199,7 +205,14 @@ Report run_check(const Options& o) {
                  o.window_s, r.gt_step_s);
   std::vector<double> lengths;
   std::size_t i = 0;
+  const double span_s = posefuse::seconds_between(gt.t_ns.back(), gt.t_ns.front());
   while (i + 1 < gt.size()) {
+    progress.update([&] {
+      char line[120];
+      std::snprintf(line, sizeof line, "window %zu at t = %.1f of %.1f s", r.windows.size() + r.skipped + 1,
+                    posefuse::seconds_between(gt.t_ns[i], gt.t_ns.front()), span_s);
+      return std::string(line);
+    });
     // Windows end on the ground-truth state nearest to t_i + window (at
     // least one step on), so the stamps' jitter does not add a step.
     std::size_t j = i + 1;

@@ -57,6 +57,7 @@
 #include <apps/cli.hpp>
 #include <apps/json.hpp>
 #include <apps/output_file.hpp>
+#include <apps/progress.hpp>
 #include <apps/svg.hpp>
 #include <posefuse/inertial/alignment.hpp>
 #include <posefuse/io/euroc.hpp>
@@ -173,8 +174,13 @@ double angle_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 }
 
 Report run_check(const Options& o) {
+  // On a terminal, standard error shows the files being read and the windows.
+  apps::TerminalProgress progress("vi_alignment_check");
+  progress.stage("reading " + o.imu.string());
   const std::vector<posefuse::ImuSample> imu = posefuse::read_euroc_imu(o.imu);
+  progress.stage("reading " + o.groundtruth.string());
   const posefuse::EurocGroundTruth gt = posefuse::read_euroc_groundtruth(o.groundtruth);
+  progress.clear();
   if (!gt.has_velocity_and_biases())
     throw apps::data_error(o.groundtruth.string() +
                            ": needs velocity and biases (17 columns); this file has poses only");
@@ -204,6 +210,9 @@ Report run_check(const Options& o) {
   std::normal_distribution<double> n01(0.0, 1.0);
   const double sigma_r = o.rot_noise_deg * std::numbers::pi / 180.0;
   for (std::size_t w0 = 0; w0 + kFrames <= kf.size(); w0 += std::size_t(o.stride)) {
+    progress.update([&] {
+      return "window at keyframe " + std::to_string(w0 + 1) + " of " + std::to_string(kf.size());
+    });
     std::array<posefuse::SE3d, kFrames> T_w_c;
     for (int k = 0; k < kFrames; ++k) {
       const std::size_t i = kf[w0 + std::size_t(k)];

@@ -324,6 +324,41 @@ TEST_CASE("evaluate_trajectory shows its stages only on a terminal", "[examples]
   CHECK(posefuse::test::slurp(out) == plain.out);
 }
 
+TEST_CASE("imu_preintegration_check and vi_alignment_check show their windows only on a terminal",
+          "[examples][contract][progress][inertial]") {
+  const TempDir dir("contract-progress-inertial");
+  const RestRecording rest = rest_recording(12.0);
+  const fs::path imu = dir.write("imu0.csv", rest.imu);
+  const fs::path gt = dir.write("gt.csv", rest.gt);
+  const std::string args = "--imu '" + imu.string() + "' --groundtruth '" + gt.string() + "' --json";
+  for (const char* program : {"imu_preintegration_check", "vi_alignment_check"}) {
+    const fs::path exe = posefuse::test::example(program);
+    if (exe.empty()) {
+      WARN("SKIPPED: example '" << program << "' not built");
+      continue;
+    }
+    INFO(program);
+    const Run plain = posefuse::test::run(exe, args, dir);
+    REQUIRE(plain.status == 0);
+    CHECK(plain.err.empty());
+    if (!fs::exists("/usr/bin/script")) {
+      WARN("SKIPPED: /usr/bin/script is not installed");
+      continue;
+    }
+    const fs::path out = dir.path() / "out.json", tty = dir.path() / "tty.txt";
+    const std::string inner = "'" + exe.string() + "' " + args + " 2>&1 >'" + out.string() + "'";
+    const std::string cmd = "/usr/bin/script -qec \"" + inner + "\" /dev/null > '" + tty.string() + "' 2>&1";
+    REQUIRE(std::system(cmd.c_str()) == 0);
+    const std::string shown = posefuse::test::slurp(tty);
+    INFO(shown);
+    CHECK(shown.find(std::string("\r") + program + ": reading " + imu.string()) != std::string::npos);
+    CHECK(shown.find(std::string("\r") + program + ": window ") != std::string::npos);
+    CHECK(shown.size() >= 4);
+    CHECK(shown.substr(shown.size() - 4) == "\r\033[K");
+    CHECK(posefuse::test::slurp(out) == plain.out);
+  }
+}
+
 TEST_CASE("ekf_custom_model: --help prints usage only, unwritable output fails",
           "[examples][contract][tutorial]") {
   POSEFUSE_REQUIRE_EXAMPLE(exe, "ekf_custom_model");
