@@ -610,29 +610,38 @@ int run_read(const Options& given, apps::SpooledInputs& spool) {
   for (const std::string& w : warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   progress.stage("associating " + std::to_string(ref_file.size()) + " and " + std::to_string(est_file.size()) +
                  " poses");
-  posefuse::Trajectory ref = thin(ref_file, o);
-  const posefuse::Trajectory est = thin(est_file, o);
+  // Thinned copies only when thinning is asked for; otherwise the poses as
+  // read are used (no copy of a possibly large file).
+  const bool thinning = o.downsample.has_value() || o.motion_filter.has_value();
+  posefuse::Trajectory ref_kept, est_kept;
+  if (thinning) {
+    ref_kept = thin(ref_file, o);
+    est_kept = thin(est_file, o);
+  }
+  const posefuse::Trajectory* ref = thinning ? &ref_kept : &ref_file;
+  const posefuse::Trajectory& est = thinning ? est_kept : est_file;
   posefuse::Trajectory ref_sync, est_sync;
   const bool frame_by_frame = o.ref_format == posefuse::Format::kKitti &&
                               o.est_format == posefuse::Format::kKitti && !o.times;
   if (frame_by_frame) {
-    if (ref.size() != est.size()) {
-      throw apps::data_error("reference has " + std::to_string(ref.size()) +
+    if (ref->size() != est.size()) {
+      throw apps::data_error("reference has " + std::to_string(ref->size()) +
                              " poses but estimate " + std::to_string(est.size()) +
                              "; KITTI files without --times are compared frame by frame");
     }
-    ref_sync = ref;
+    ref_sync = *ref;
     est_sync = est;
   } else {
     if (o.t_start || o.t_end) {
-      ref = posefuse::reduce_to_time_range(ref, o.t_start, o.t_end);
-      if (ref.empty()) {
+      ref_kept = posefuse::reduce_to_time_range(*ref, o.t_start, o.t_end);
+      ref = &ref_kept;
+      if (ref->empty()) {
         throw apps::data_error(o.groundtruth.string() + ": no pose between --t-start and --t-end (" +
                                apps::shortest(ref_file.t_s.front()) + " to " +
                                apps::shortest(ref_file.t_s.back()) + " s in the file)");
       }
     }
-    posefuse::AssociatedTrajectories sync = posefuse::associate(ref, est, o.max_time_diff, o.t_offset);
+    posefuse::AssociatedTrajectories sync = posefuse::associate(*ref, est, o.max_time_diff, o.t_offset);
     ref_sync = std::move(sync.ref);
     est_sync = std::move(sync.est);
   }
