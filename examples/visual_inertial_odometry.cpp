@@ -60,7 +60,7 @@ struct Options {
   bool no_fej = false;
   bool no_reuse = false;
   double min_parallax_px = 10.0;
-  double outlier_px = 3.0;
+  double outlier_px = 5.26;
   std::size_t max_frames = 0;
   posefuse::ImuNoise noise;  // the EuRoC IMU's datasheet figures (imu0 sensor.yaml)
   bool json = false;
@@ -106,7 +106,7 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   cli.real({.name = "--min-parallax", .value = "PX", .help = "keyframe parallax", .default_text = "10"},
            o.min_parallax_px, apps::Domain::kPositive);
   cli.real({.name = "--outlier-px", .value = "PX", .help = "reprojection error of an outlier",
-            .default_text = "3"},
+            .default_text = "5.26"},
            o.outlier_px, apps::Domain::kPositive);
   cli.custom({.name = "--imu-noise", .value = "NA,NG,WA,WG",
               .help = "accelerometer and gyroscope noise densities, then their random walks\n"

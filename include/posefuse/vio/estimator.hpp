@@ -17,6 +17,10 @@
 /// stated standard deviations (position and yaw fix the gauge; roll and
 /// pitch in the world frame).
 ///
+/// **Rest.** A frame whose features have not moved since the last keyframe
+/// (is_stationary, vio/sliding_window.hpp) gets a zero-velocity factor
+/// (vio/window_problem.hpp), as does the first frame of a static start.
+///
 /// **Status** of each frame: kInitializing (no state yet: nothing written),
 /// kTracking, kNotEnoughFeatures (fewer than `min_features` triangulated
 /// features seen in the frame: the state rests mostly on the IMU),
@@ -122,6 +126,7 @@ class VioEstimator {
         x0 = *si.state;
       }
       start_window(frame.t_ns, x0);
+      w_.frames.back().stationary = !initial_;  // the static start found the body at rest
       add_observations(frame);
       last_good_ = w_.frames.back().x;
       res.status = VioStatus::kNotEnoughFeatures;
@@ -147,6 +152,12 @@ class VioEstimator {
     const ImuState predicted = f.x;
     w_.frames.push_back(std::move(f));
     add_observations(frame);
+    {
+      // At rest against the last keyframe (the frame before the previous one once the window is full).
+      const std::size_t n = w_.frames.size();
+      const std::size_t ref = n >= 3 ? n - 3 : 0;
+      w_.frames.back().stationary = is_stationary(w_, ref, n - 1, o_.window);
+    }
     (void)triangulate_features(w_, o_.window);
     const VioWindow before = w_;
     const WindowSolveSummary s = problem_.solve(w_, o_.window.solve);

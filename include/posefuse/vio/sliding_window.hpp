@@ -48,11 +48,17 @@ struct SlidingWindowOptions {
   int min_tracked = 20;                      ///< keyframe test: fewer shared features makes a keyframe
   double focal_px = 460.0;                   ///< focal length that converts parallax to pixels
   double pixel_sigma_px = 1.0;               ///< σ of the reprojection residuals
-  double outlier_threshold_px = 3.0;         ///< reprojection error above this is an outlier
+  /// Reprojection error above this is an outlier: the 99.9 % bound of χ²(2)
+  /// for a residual of variance 2σ² per axis (the anchor's pixel noise and
+  /// the observer's), \f$ \sqrt{2 \cdot 13.82}\,\sigma = 5.26\,\sigma \f$ at σ = 1 px.
+  double outlier_threshold_px = 5.26;
   double min_depth_m = 0.1;                  ///< triangulation: nearest accepted point
   double max_depth_m = 200.0;                ///< triangulation: farthest accepted point
   double min_ray_angle_rad = 0.5 * 3.14159265358979 / 180.0;  ///< triangulation: least ray angle
   bool reuse_marginalised_tracks = true;     ///< see the file comment
+  /// Rest test (is_stationary): the median image displacement of the shared
+  /// features is below this many pixel σ (pure noise gives a median of 1.67 σ).
+  double stationary_displacement_sigmas = 2.5;
   WindowSolveOptions solve;                  ///< the LM solve
 };
 
@@ -93,6 +99,33 @@ inline int triangulate_features(VioWindow& w, const SlidingWindowOptions& o) {
   return sum / shared * o.focal_px >= o.min_parallax_px;
 }
 
+/// Rest test of the frame at `slot` against the keyframe at `ref`: at least
+/// `min_tracked` features seen in both, and the median of their displacements
+/// (px at the focal length) below `stationary_displacement_sigmas` pixel σ —
+/// what pixel noise alone explains (the median of the displacement of a
+/// point that does not move is \f$ \sqrt{2\ln 4}\,\sigma \approx 1.67\sigma \f$). The median, not the mean, so that
+/// wrong associations do not decide. Comparing against the last keyframe
+/// rather than the previous image lets slow motion accumulate until it shows.
+[[nodiscard]] inline bool is_stationary(const VioWindow& w, std::size_t ref, std::size_t slot,
+                                        const SlidingWindowOptions& o) {
+  if (ref >= slot || slot >= w.frames.size()) return false;
+  const std::uint64_t a = w.frames[ref].id, b = w.frames[slot].id;
+  std::vector<double> d;
+  for (const auto& [id, l] : w.landmarks) {
+    const VioObservation* oa = nullptr;
+    const VioObservation* ob = nullptr;
+    for (const VioObservation& ob_ : l.obs) {
+      if (ob_.frame_id == a) oa = &ob_;
+      if (ob_.frame_id == b) ob = &ob_;
+    }
+    if (oa && ob) d.push_back((oa->m - ob->m).norm() * o.focal_px);
+  }
+  if (int(d.size()) < o.min_tracked) return false;
+  const auto mid = d.begin() + std::ptrdiff_t(d.size() / 2);
+  std::nth_element(d.begin(), mid, d.end());
+  return *mid < o.stationary_displacement_sigmas * o.pixel_sigma_px;
+}
+
 /// Marginalises the oldest keyframe (file comment).
 inline void marginalize_oldest(VioWindow& w, const SlidingWindowOptions& o, WindowProblem& P) {
   if (w.frames.size() < 2) return;
@@ -103,6 +136,8 @@ inline void marginalize_oldest(VioWindow& w, const SlidingWindowOptions& o, Wind
   WindowSelection sel;
   sel.imu.assign(w.frames.size(), 0);
   sel.imu[1] = 1;
+  sel.zero_velocity.assign(w.frames.size(), 0);
+  sel.zero_velocity[0] = 1;
   sel.landmarks = &gone;
   P.linearize(w, o.solve, sel);
   Eigen::MatrixXd Hs;

@@ -39,6 +39,12 @@
 /// from the current bias estimate of its first keyframe is re-integrated
 /// (Preintegration::update_bias) and its IMU factor rebuilt.
 ///
+/// **Zero velocity.** A keyframe marked `stationary` (the image shows no
+/// motion, vio/estimator.hpp) has the residual \f$ v / \sigma_0 \f$ with
+/// \f$ \sigma_0 \f$ = `stationary_velocity_sigma_mps`: at rest the features
+/// cannot be triangulated, and without it the IMU alone would let the
+/// velocity, hence the position, drift.
+///
 /// Observations whose point lies closer than `min_depth` in front of the
 /// observing camera, and features with λ <= 0, contribute nothing (the same
 /// rule in the cost and in the linearisation).
@@ -62,6 +68,7 @@ struct WindowSolveOptions {
   ReprojectionLoss loss{ReprojectionLoss::Kind::kCauchy, 1.0};  ///< on residuals in units of σ
   bool first_estimate_jacobians = true;    ///< see the file comment
   double min_depth = 0.05;                 ///< observations closer than this (m) are ignored
+  double stationary_velocity_sigma_mps = 0.01;  ///< σ of the zero-velocity factor of a stationary keyframe
 };
 
 /// What a solve did.
@@ -78,6 +85,9 @@ struct WindowSolveSummary {
 struct WindowSelection {
   bool prior = true;                                      ///< the marginalisation prior
   std::vector<char> imu;                                  ///< per slot k: the factor (k-1, k); empty = all
+  /// per slot k: the zero-velocity factor of a stationary frame; empty =
+  /// all when `imu` is empty too, none otherwise
+  std::vector<char> zero_velocity;
   const std::vector<std::uint64_t>* landmarks = nullptr;  ///< feature ids; null = all initialised
 };
 
@@ -91,6 +101,8 @@ class WindowProblem {
     if (w.prior) F += prior_residual(w).squaredNorm();
     for (std::size_t k = 1; k < w.frames.size(); ++k)
       if (w.frames[k].imu) F += w.frames[k].imu->whitened_residual(w.frames[k - 1].x, w.frames[k].x).squaredNorm();
+    for (const VioFrame& f : w.frames)
+      if (f.stationary) F += f.x.v.squaredNorm() / (o.stationary_velocity_sigma_mps * o.stationary_velocity_sigma_mps);
     for (const auto& [id, l] : w.landmarks) {
       if (!l.initialised || !(l.inv_depth > 0)) continue;
       const RigidPose Ta = VioFrame::pose(w.frames[std::size_t(w.slot_of(l.obs[0].frame_id))].x);
@@ -157,6 +169,14 @@ class WindowProblem {
       H_.block<15, 15>(oj, oi) = H_.block<15, 15>(oi, oj).transpose();
       b_.segment<15>(oi).noalias() += Ji.transpose() * r;
       b_.segment<15>(oj).noalias() += Jj.transpose() * r;
+    }
+    const double zv = 1.0 / (o.stationary_velocity_sigma_mps * o.stationary_velocity_sigma_mps);
+    for (std::size_t k = 0; k < w.frames.size(); ++k) {
+      const bool take = sel.zero_velocity.empty() ? sel.imu.empty() : sel.zero_velocity[k] != 0;
+      if (!w.frames[k].stationary || !take) continue;
+      const int ov = 15 * int(k) + 6;
+      H_.block<3, 3>(ov, ov).diagonal().array() += zv;
+      b_.segment<3>(ov).noalias() += zv * w.frames[k].x.v;
     }
     const RigidPose Tbc_lin = o.first_estimate_jacobians && w.T_bc_fej ? *w.T_bc_fej : w.T_bc;
     const auto visit = [&](std::uint64_t id, const VioLandmark& l) {

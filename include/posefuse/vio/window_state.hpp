@@ -38,6 +38,7 @@ struct VioFrame {
   std::optional<ImuState> fej;       ///< first estimate, set once the frame enters the prior
   Preintegration pre;                ///< IMU from the previous keyframe to this one (empty for the first)
   std::optional<ImuFactor> imu;      ///< factor built from `pre` (absent for the first frame)
+  bool stationary = false;           ///< at rest: a zero-velocity factor (vio/window_problem.hpp) holds v
   /// The pose part \f$ (p, R) \f$ of a state.
   [[nodiscard]] static RigidPose pose(const ImuState& s) { return RigidPose{s.p, s.R}; }
 };
