@@ -1,7 +1,8 @@
 // Consistency of the sliding window (vio/sliding_window.hpp,
 // vio/window_problem.hpp): the four unobservable directions after many
-// marginalisations, with and without first-estimate Jacobians, and a
-// Monte-Carlo NEES of the window estimate.
+// marginalisations, with and without first-estimate Jacobians, a
+// Monte-Carlo NEES of the window estimate, and the sliding window against
+// the batch solution on a near-linear problem.
 #include <catch2/catch.hpp>
 
 #include <Eigen/Eigenvalues>
@@ -245,4 +246,88 @@ TEST_CASE("Sliding window: after 50 marginalisations the four unobservable direc
   for (int i = 0; i < 3; ++i) CHECK(b.hn(i) <= 1e-12);
   CHECK(b.hn(3) >= 1e-9);
   CHECK(b.ev(3) >= 1e-10);
+}
+
+TEST_CASE("Sliding window: on a near-linear problem the estimate and covariance of the newest pose equal "
+          "the batch solution of all measurements",
+          "[vio][window][batch]") {
+  // 25 frames, 0.2 px noise, every track cut to the window's span (10
+  // frames from its anchor) so that marginalisation drops no measurement
+  // and uses none twice (reuse_marginalised_tracks off); a prior holds frame 0
+  // in both. Batch: one window of all 25 frames, solved to convergence.
+  const int size = 10;
+  auto fx = vio_test::make_window(21, 25, 500, 20, 0.2);
+  for (auto& [id, l] : fx.truth.landmarks) {
+    const std::uint64_t last = l.obs.front().frame_id + std::uint64_t(size - 1);
+    while (l.obs.back().frame_id > last) l.obs.pop_back();
+  }
+  const VioFrame& f0 = fx.truth.frames[0];
+  VioPrior anchor;
+  anchor.linear.J = 1e3 * Eigen::MatrixXd::Identity(15, 15);
+  anchor.linear.r0 = Eigen::VectorXd::Zero(15);
+  for (int i = 0; i < 15; ++i) anchor.linear.kept.push_back(i);
+  anchor.blocks.push_back(VioPriorBlock{false, f0.id, f0.x, RigidPose{}});
+  WindowSolveOptions so;
+  so.loss.kind = ReprojectionLoss::Kind::kNone;
+  so.max_iterations = 30;
+  const auto newest = [&](const VioWindow& w, const WindowSolveOptions& o, Eigen::Matrix<double, 6, 6>& cov) {
+    WindowProblem P;
+    P.linearize(w, o);
+    Eigen::MatrixXd Hs;
+    Eigen::VectorXd bs;
+    P.reduced(Hs, bs);
+    const int off = 15 * int(w.frames.size() - 1);
+    cov = Hs.ldlt().solve(Eigen::MatrixXd::Identity(Hs.rows(), Hs.cols())).block<6, 6>(off, off);
+    return w.frames.back().x;
+  };
+  // Batch.
+  VioWindow batch = fx.truth;
+  batch.prior = anchor;
+  WindowProblem Pb;
+  (void)Pb.solve(batch, so);
+  Eigen::Matrix<double, 6, 6> cov_b;
+  const ImuState xb = newest(batch, so, cov_b);
+  // Sliding window.
+  SlidingWindowOptions o;
+  o.solve = so;
+  o.reuse_marginalised_tracks = false;
+  VioWindow w;
+  w.T_bc = fx.truth.T_bc;
+  w.gravity_w = fx.truth.gravity_w;
+  w.sqrt_info = fx.truth.sqrt_info;
+  w.prior = anchor;
+  WindowProblem P;
+  for (std::size_t k = 0; k < fx.truth.frames.size(); ++k) {
+    if (int(w.frames.size()) == size) marginalize_oldest(w, o, P);
+    VioFrame f = fx.truth.frames[k];
+    if (!w.frames.empty()) f.x = f.imu->predict(w.frames.back().x);
+    else f.imu.reset();
+    w.frames.push_back(f);
+    for (const auto& [id, l] : fx.truth.landmarks)
+      if (l.obs.front().frame_id <= f.id && l.obs.back().frame_id >= f.id) {
+        VioLandmark& wl = w.landmarks[id];
+        for (const VioObservation& ob : l.obs)
+          if (ob.frame_id == f.id) wl.obs.push_back(ob);
+        if (wl.obs.size() == 2) {  // true depth as the start (the solve refines it)
+          wl.inv_depth = l.inv_depth;
+          wl.initialised = true;
+        }
+      }
+    if (int(w.frames.size()) >= 2) (void)P.solve(w, so);
+  }
+  Eigen::Matrix<double, 6, 6> cov_s;
+  const ImuState xs = newest(w, so, cov_s);
+  Eigen::Matrix<double, 6, 1> d;
+  d << xs.p - xb.p, xs.R.minus(xb.R);
+  const double mahal = std::sqrt(d.dot(cov_b.ldlt().solve(d)));
+  const double cov_rel = (cov_s - cov_b).norm() / cov_b.norm();
+  const double err_b = (xb.p - fx.truth.frames.back().x.p).norm();
+  INFO("newest pose: sliding - batch = " << d.transpose() << " (Mahalanobis " << mahal << " in the batch covariance; "
+                                         << "batch error " << err_b << " m); |cov_s - cov_b| / |cov_b| = " << cov_rel
+                                         << "; sqrt(diag cov_b) " << cov_b.diagonal().cwiseSqrt().transpose());
+  // Measured: the newest poses differ by 3.5e-6 m (8.0e-4 in the batch's
+  // Mahalanobis norm, while the batch itself is 6.9e-4 m from the truth);
+  // the covariances by 5.3e-4 relative (Frobenius).
+  CHECK(mahal <= 1e-2);
+  CHECK(cov_rel <= 5e-3);
 }
