@@ -65,7 +65,9 @@ struct WindowSolveOptions {
   int max_iterations = 10;                 ///< cap on LM trials (each one linear solve)
   double initial_damping = 1e-4;           ///< initial μ
   double function_tolerance = 1e-10;       ///< stop when |ΔF| / F falls below this
-  ReprojectionLoss loss{ReprojectionLoss::Kind::kCauchy, 1.0};  ///< on residuals in units of σ
+  /// On residuals in units of σ; the scale √2 is one standard deviation of a
+  /// residual that carries the anchor's and the observer's pixel noise.
+  ReprojectionLoss loss{ReprojectionLoss::Kind::kCauchy, 1.4142135623730951};
   bool first_estimate_jacobians = true;    ///< see the file comment
   double min_depth = 0.05;                 ///< observations closer than this (m) are ignored
   double stationary_velocity_sigma_mps = 0.01;  ///< σ of the zero-velocity factor of a stationary keyframe
