@@ -56,6 +56,7 @@
 #include <posefuse/core/samples.hpp>
 #include <posefuse/io/robot_log.hpp>
 #include <posefuse/sim/corridor_config.hpp>
+#include <posefuse/sim/detail/rng.hpp>
 
 namespace posefuse::sim {
 
@@ -78,30 +79,6 @@ struct CorridorSimulation {
 };
 
 namespace detail {
-
-/// mt19937_64 with a portable normal (Box-Muller) and uniform.
-class SimRng {
- public:
-  explicit SimRng(std::uint64_t seed) : g_(seed) {}
-  double uniform() { return double(g_() >> 11) * 0x1.0p-53; }  // [0, 1)
-  double uniform(double a, double b) { return a + (b - a) * uniform(); }
-  double normal(double sigma = 1.0) {
-    if (has_spare_) {
-      has_spare_ = false;
-      return sigma * spare_;
-    }
-    const double u1 = 1.0 - uniform(), u2 = uniform();
-    const double r = std::sqrt(-2.0 * std::log(u1)), a = 2.0 * std::numbers::pi * u2;
-    spare_ = r * std::sin(a);
-    has_spare_ = true;
-    return sigma * r * std::cos(a);
-  }
-
- private:
-  std::mt19937_64 g_;
-  double spare_ = 0;
-  bool has_spare_ = false;
-};
 
 /// Trapezoidal profile over distance D: s(t), v(t), a(t) for t in [0, T].
 struct Trapezoid {
@@ -171,7 +148,7 @@ inline TruthState truth_at(const std::vector<Segment>& segs, double t) {
 
 /// Sample times (s) of a stream with a phase offset and uniform jitter.
 inline std::vector<double> sample_times(double rate_hz, double phase_s, double jitter_s,
-                                        double duration_s, SimRng& rng) {
+                                        double duration_s, SeededRng& rng) {
   std::vector<double> t;
   const double dt = 1.0 / rate_hz;
   for (double k = 0;; ++k) {
@@ -213,7 +190,7 @@ inline std::array<double, 4> quat_from_zyx(double yaw, double pitch, double roll
   validate(cfg);
   using detail::Segment;
   using detail::Trapezoid;
-  detail::SimRng rng(seed);
+  detail::SeededRng rng(seed);
   constexpr double kPi = std::numbers::pi;
   CorridorSimulation out;
   // --- The drive: still, then 4 x (leg, pause, turn, pause), then still.

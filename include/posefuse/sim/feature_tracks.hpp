@@ -163,7 +163,7 @@ struct SimulatedTracks {
   for (std::size_t k = 1; k < t_ns.size(); ++k)
     if (!(t_ns[k] > t_ns[k - 1])) throw invalid_argument("simulate_feature_tracks: stamps must increase");
 
-  detail::TrackRng rng(config.seed);
+  detail::SeededRng rng(config.seed);
   SimulatedTracks out;
   out.T_W_B = T_W_B;
   std::vector<Eigen::Isometry3d> T_W_C;

@@ -1,8 +1,8 @@
 #pragma once
 /// @file
 /// The scene of the feature-track simulator (sim/feature_tracks.hpp; not
-/// API): its random numbers and its landmarks (room walls around the path,
-/// free points at stated depths in front of the camera).
+/// API): its landmarks, on the room walls around the path and free at
+/// stated depths in front of the camera.
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -14,44 +14,10 @@
 #include <random>
 #include <vector>
 
+#include <posefuse/sim/detail/rng.hpp>
 #include <posefuse/vio/camera.hpp>
 
 namespace posefuse::sim::detail {
-
-/// mt19937_64 with a portable uniform and normal (Box-Muller), so that a
-/// seed gives the same numbers with every standard library.
-class TrackRng {
- public:
-  explicit TrackRng(std::uint64_t seed) : g_(seed) {}
-  /// Uniform in [0, 1) from the top 53 bits.
-  double uniform() { return double(g_() >> 11) * 0x1.0p-53; }
-  /// Uniform in [a, b).
-  double uniform(double a, double b) { return a + (b - a) * uniform(); }
-  /// Uniform integer in [0, n), n > 0.
-  std::size_t below(std::size_t n) { return std::min(n - 1, std::size_t(uniform() * double(n))); }
-  /// Normal with standard deviation sigma.
-  double normal(double sigma) {
-    if (has_spare_) {
-      has_spare_ = false;
-      return sigma * spare_;
-    }
-    const double u1 = 1.0 - uniform(), u2 = uniform();
-    const double r = std::sqrt(-2.0 * std::log(u1)), a = 2.0 * std::numbers::pi * u2;
-    spare_ = r * std::sin(a);
-    has_spare_ = true;
-    return sigma * r * std::cos(a);
-  }
-  /// Fisher-Yates shuffle.
-  template <class T>
-  void shuffle(std::vector<T>& v) {
-    for (std::size_t i = v.size(); i > 1; --i) std::swap(v[i - 1], v[below(i)]);
-  }
-
- private:
-  std::mt19937_64 g_;
-  double spare_ = 0;
-  bool has_spare_ = false;
-};
 
 /// The axis-aligned room: the bounding box of the camera positions grown by
 /// `margin` on every side.
@@ -75,7 +41,7 @@ struct Room {
 
 /// Landmarks uniformly on the six faces of the room, `density` per m²
 /// (each face gets round(area * density)).
-inline void add_wall_landmarks(const Room& room, double density, TrackRng& rng,
+inline void add_wall_landmarks(const Room& room, double density, SeededRng& rng,
                                std::vector<Eigen::Vector3d>& out) {
   const Eigen::Vector3d size = room.hi - room.lo;
   for (int axis = 0; axis < 3; ++axis) {
@@ -99,7 +65,7 @@ inline void add_wall_landmarks(const Room& room, double density, TrackRng& rng,
 /// up to 20 draws per point, so fewer than `count` when the room is small.
 inline void add_free_landmarks(const std::vector<Eigen::Isometry3d>& T_W_C, const PinholeRadtan& cam,
                                const Room& room, std::size_t count, double depth_min, double depth_max,
-                               TrackRng& rng, std::vector<Eigen::Vector3d>& out) {
+                               SeededRng& rng, std::vector<Eigen::Vector3d>& out) {
   for (std::size_t i = 0; i < count; ++i) {
     for (int attempt = 0; attempt < 20; ++attempt) {
       const Eigen::Isometry3d& T = T_W_C[rng.below(T_W_C.size())];
