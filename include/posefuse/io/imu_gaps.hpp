@@ -66,33 +66,25 @@ template <class Lazy = void>
                                                             std::int64_t max_interval_ns) {
   if (max_interval_ns <= 0)
     throw invalid_argument("read_euroc_imu_checked: the gap limit must be > 0 ns");
+  std::vector<ImuSample> samples = read_euroc_imu(file);  // every check of the reader
+  const std::vector<ImuGap> gaps = find_imu_gaps(samples, max_interval_ns);
+  if (gaps.empty()) return samples;
+  // Only on failure: a second pass finds the lines of the samples around the
+  // first gap (data lines are the lines that are neither blank nor comments).
+  const std::size_t after = gaps.front().index;
   detail::LineReader reader(file);
-  std::vector<ImuSample> out;
-  std::vector<double> v;
   std::string line;
-  std::size_t previous_line = 0;
-  const auto ms = [](std::int64_t ns) { return detail::traj_io::format_number(double(ns) * 1e-6); };
-  while (reader.next(line)) {
+  std::size_t data_lines = 0, line_before = 0, line_after = 0;
+  while (line_after == 0 && reader.next(line)) {
     if (detail::traj_io::is_blank_or_comment(line)) continue;
-    const std::size_t n = reader.line_no();
-    ImuSample s;
-    detail::euroc_io::parse_line(line, 7, "t[ns], wx, wy, wz [rad/s], ax, ay, az [m/s^2]", file, n,
-                                 s.t_ns, v);
-    if (!out.empty()) {
-      detail::euroc_io::check_order(s.t_ns, out.back().t_ns, previous_line, file, n);
-      const std::int64_t dt = s.t_ns - out.back().t_ns;
-      if (dt > max_interval_ns)
-        throw io_error(file, n,
-                       "gap of " + ms(dt) + " ms after line " + std::to_string(previous_line) +
-                           " (the limit is " + ms(max_interval_ns) + " ms)");
-    }
-    s.gyro_radps = Eigen::Vector3d(v[0], v[1], v[2]);
-    s.accel_mps2 = Eigen::Vector3d(v[3], v[4], v[5]);
-    out.push_back(s);
-    previous_line = n;
+    if (data_lines == after - 1) line_before = reader.line_no();
+    if (data_lines == after) line_after = reader.line_no();
+    ++data_lines;
   }
-  if (out.empty()) throw io_error(file, "no IMU samples (the file has no data lines)");
-  return out;
+  const auto ms = [](std::int64_t ns) { return detail::traj_io::format_number(double(ns) * 1e-6); };
+  throw io_error(file, line_after,
+                 "gap of " + ms(gaps.front().length_ns()) + " ms after line " + std::to_string(line_before) +
+                     " (the limit is " + ms(max_interval_ns) + " ms)");
 }
 
 }  // namespace posefuse
