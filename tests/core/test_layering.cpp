@@ -42,6 +42,19 @@ struct Arrow {
 
 fs::path include_root() { return fs::path(POSEFUSE_SOURCE_DIR) / "include" / "posefuse"; }
 
+// Calls f(path, line_no, text) for every line of every file under
+// include/posefuse (lines numbered from 1).
+template <class F>
+void for_each_library_line(F f) {
+  for (const auto& entry : fs::recursive_directory_iterator(include_root())) {
+    if (!entry.is_regular_file()) continue;
+    std::ifstream in(entry.path());
+    std::string text;
+    int line_no = 0;
+    while (std::getline(in, text)) f(entry.path(), ++line_no, text);
+  }
+}
+
 // Folder of a header relative to include/posefuse ("" for the umbrella).
 std::string folder_of(const fs::path& rel) {
   return rel.has_parent_path() ? rel.begin()->string() : std::string();
@@ -105,17 +118,10 @@ TEST_CASE("Layering: the seed programs' code is not in the library", "[core][lay
   }
   // And no library header reaches into examples/apps.
   const std::regex apps_re(R"(^\s*#\s*include\s*[<"]apps/)");
-  for (const auto& entry : fs::recursive_directory_iterator(include_root())) {
-    if (!entry.is_regular_file()) continue;
-    std::ifstream in(entry.path());
-    std::string text;
-    int line_no = 0;
-    while (std::getline(in, text)) {
-      ++line_no;
-      INFO(entry.path().string() << ":" << line_no);
-      CHECK_FALSE(std::regex_search(text, apps_re));
-    }
-  }
+  for_each_library_line([&](const fs::path& file, int line_no, const std::string& text) {
+    INFO(file.string() << ":" << line_no);
+    CHECK_FALSE(std::regex_search(text, apps_re));
+  });
 }
 
 TEST_CASE("Layering: headers name only documents that are in the repository", "[core][layering]") {
@@ -126,24 +132,16 @@ TEST_CASE("Layering: headers name only documents that are in the repository", "[
   const std::regex doc_re(R"(([A-Za-z0-9_./-]+)\.md\b)");
   const std::regex outside_re(R"(\.\./shared|\.\./\.\./)");
   int named = 0;
-  for (const auto& entry : fs::recursive_directory_iterator(include_root())) {
-    if (!entry.is_regular_file()) continue;
-    std::ifstream in(entry.path());
-    std::string text;
-    int line_no = 0;
-    while (std::getline(in, text)) {
-      ++line_no;
-      const std::string where = fs::relative(entry.path(), root).string() + ":" + std::to_string(line_no);
-      INFO(where << ": " << text);
-      CHECK_FALSE(std::regex_search(text, outside_re));
-      for (std::sregex_iterator it(text.begin(), text.end(), doc_re), end; it != end; ++it) {
-        ++named;
-        const std::string doc = (*it)[1].str() + ".md";
-        INFO("names " << doc);
-        CHECK(fs::is_regular_file(root / doc));
-      }
+  for_each_library_line([&](const fs::path& file, int line_no, const std::string& text) {
+    INFO(fs::relative(file, root).string() << ":" << line_no << ": " << text);
+    CHECK_FALSE(std::regex_search(text, outside_re));
+    for (std::sregex_iterator it(text.begin(), text.end(), doc_re), end; it != end; ++it) {
+      ++named;
+      const std::string doc = (*it)[1].str() + ".md";
+      INFO("names " << doc);
+      CHECK(fs::is_regular_file(root / doc));
     }
-  }
+  });
   // The check above must have something to check: the headers do point to docs/.
   CHECK(named > 0);
 }

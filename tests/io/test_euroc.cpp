@@ -8,6 +8,7 @@
 #include <posefuse/io/euroc.hpp>
 
 #include "support/data_path.hpp"
+#include "support/io_error.hpp"
 #include "support/temp_dir.hpp"
 
 namespace {
@@ -16,16 +17,7 @@ const char* kImuHeader =
     "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],"
     "a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\n";
 
-// The message of the io_error thrown by f, or "" when none is thrown.
-template <class F>
-std::string error_of(F f) {
-  try {
-    f();
-  } catch (const posefuse::io_error& e) {
-    return e.what();
-  }
-  return "";
-}
+using posefuse::test::io_error_of;
 
 }  // namespace
 
@@ -48,7 +40,7 @@ TEST_CASE("EuRoC: malformed IMU files give file:line errors", "[io][euroc]") {
   posefuse::test::TempDir dir("euroc");
   const std::string good = "1000,0,0,0,0,0,9.81\n";
   const auto bad = [&](const std::string& line) {
-    return error_of([&] {
+    return io_error_of([&] {
       (void)posefuse::read_euroc_imu(dir.write("bad.csv", std::string(kImuHeader) + good + line));
     });
   };
@@ -59,9 +51,9 @@ TEST_CASE("EuRoC: malformed IMU files give file:line errors", "[io][euroc]") {
   CHECK_THAT(bad("99999999999999999999,0,0,0,0,0,9.81\n"), Catch::Contains("bad.csv:3: timestamp"));
   CHECK_THAT(bad("1000,0,0,0,0,0,9.81\n"), Catch::Contains("bad.csv:3: timestamp 1000 repeats the previous one (1000 on line 2)"));
   CHECK_THAT(bad("999,0,0,0,0,0,9.81\n"), Catch::Contains("bad.csv:3: timestamp 999 is earlier than the previous one"));
-  CHECK_THAT(error_of([&] { (void)posefuse::read_euroc_imu(dir.write("empty.csv", kImuHeader)); }),
+  CHECK_THAT(io_error_of([&] { (void)posefuse::read_euroc_imu(dir.write("empty.csv", kImuHeader)); }),
              Catch::Contains("empty.csv: no IMU samples"));
-  CHECK_THAT(error_of([&] { (void)posefuse::read_euroc_imu(dir.path() / "missing.csv"); }),
+  CHECK_THAT(io_error_of([&] { (void)posefuse::read_euroc_imu(dir.path() / "missing.csv"); }),
              Catch::Contains("missing.csv"));
 }
 
@@ -90,7 +82,7 @@ TEST_CASE("EuRoC: ground truth with 8 or 17 columns", "[io][euroc]") {
   CHECK((*g17.accel_bias)[0] == Eigen::Vector3d(-0.1, -0.2, -0.3));
 
   const auto bad = [&](const std::string& text) {
-    return error_of([&] { (void)posefuse::read_euroc_groundtruth(dir.write("bad.csv", text)); });
+    return io_error_of([&] { (void)posefuse::read_euroc_groundtruth(dir.write("bad.csv", text)); });
   };
   CHECK_THAT(bad("1000,1,2,3,1,0,0\n"), Catch::Contains("bad.csv:1: expected 8 fields"));
   CHECK_THAT(bad("1000,1,2,3,1,0,0,0\n2000,1,2,3,1,0,0,0,0\n"),

@@ -14,6 +14,7 @@
 #include <posefuse/vio/camera.hpp>
 
 #include "support/data_path.hpp"
+#include "support/io_error.hpp"
 #include "support/temp_dir.hpp"
 
 namespace {
@@ -45,15 +46,7 @@ distortion_model: radial-tangential
 distortion_coefficients: [-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05]
 )";
 
-template <class F>
-std::string error_of(F f) {
-  try {
-    f();
-  } catch (const posefuse::io_error& e) {
-    return e.what();
-  }
-  return "";
-}
+using posefuse::test::io_error_of;
 
 // kEurocCam0 with the line starting with `key` replaced by `line` ("" drops it).
 std::string with_line(const std::string& key, const std::string& line) {
@@ -121,7 +114,7 @@ TEST_CASE("Camera: sensor.yaml errors name file:line or the missing key", "[vio]
   posefuse::test::TempDir dir("camera");
   const auto err = [&](const std::string& text) {
     const auto f = dir.write("c.yaml", text);
-    return error_of([&] { (void)posefuse::read_euroc_camera(f); });
+    return io_error_of([&] { (void)posefuse::read_euroc_camera(f); });
   };
   CHECK_THAT(err(with_line("intrinsics", "")), Catch::Contains("c.yaml: no 'intrinsics' key"));
   CHECK_THAT(err(with_line("intrinsics", "intrinsics: [458.654, 457.296, 367.215]")),

@@ -12,21 +12,10 @@
 #include <posefuse/vio/feature_tracks.hpp>
 
 #include "support/data_path.hpp"
+#include "support/io_error.hpp"
 #include "support/temp_dir.hpp"
 
-namespace {
-
-template <class F>
-std::string error_of(F f) {
-  try {
-    f();
-  } catch (const posefuse::io_error& e) {
-    return e.what();
-  }
-  return "";
-}
-
-}  // namespace
+using posefuse::test::io_error_of;
 
 TEST_CASE("Feature tracks: csv rows grouped into frames, header and comments", "[vio][tracks]") {
   posefuse::test::TempDir dir("tracks");
@@ -84,7 +73,7 @@ TEST_CASE("Feature tracks: malformed rows are file:line errors", "[vio][tracks]"
   const posefuse::PinholeRadtan cam = posefuse::sim::synthetic_camera();
   const auto err = [&](const std::string& rows) {
     const auto f = dir.write("t.csv", "t_ns,feature_id,u,v\n1000,1,10,20\n" + rows);
-    return error_of([&] { (void)posefuse::read_feature_tracks(f, cam); });
+    return io_error_of([&] { (void)posefuse::read_feature_tracks(f, cam); });
   };
   CHECK_THAT(err("2000,1,10\n"), Catch::Contains("t.csv:3: expected 4 comma-separated fields"));
   CHECK_THAT(err("2000,1,10,20,5\n"), Catch::Contains("t.csv:3: expected 4 comma-separated fields"));
@@ -104,9 +93,9 @@ TEST_CASE("Feature tracks: malformed rows are file:line errors", "[vio][tracks]"
   CHECK_THAT(err("t_ns,feature_id,u,v\n"), Catch::Contains("t.csv:3: cannot parse 't_ns' in column 1"));
   // Without a camera, pixels are not checked.
   CHECK_NOTHROW(posefuse::read_feature_tracks(dir.write("t2.csv", "1,1,-100,5000\n")));
-  CHECK_THAT(error_of([&] { (void)posefuse::read_feature_tracks(dir.write("e.csv", "# only\nt_ns,feature_id,u,v\n")); }),
+  CHECK_THAT(io_error_of([&] { (void)posefuse::read_feature_tracks(dir.write("e.csv", "# only\nt_ns,feature_id,u,v\n")); }),
              Catch::Contains("e.csv: no feature observations"));
-  CHECK_THAT(error_of([&] { (void)posefuse::read_feature_tracks(dir.path() / "missing.csv"); }),
+  CHECK_THAT(io_error_of([&] { (void)posefuse::read_feature_tracks(dir.path() / "missing.csv"); }),
              Catch::Contains("missing.csv"));
 }
 
@@ -127,13 +116,13 @@ TEST_CASE("IMU gaps: reported, or refused at the line after the gap", "[vio][imu
   CHECK(gaps[0].t_before_ns == 10'000'000);
   CHECK(gaps[0].length_ns() == 30'000'000);
   CHECK(posefuse::find_imu_gaps(s, 30'000'000).empty());  // the limit itself is accepted
-  CHECK_THAT(error_of([&] { (void)posefuse::read_euroc_imu_checked(f, 20'000'000); }),
+  CHECK_THAT(io_error_of([&] { (void)posefuse::read_euroc_imu_checked(f, 20'000'000); }),
              Catch::Contains("imu.csv:6: gap of 30 ms after line 4 (the limit is 20 ms)"));
   CHECK(posefuse::read_euroc_imu_checked(f, 30'000'000) == s);
   CHECK_THROWS_AS(posefuse::find_imu_gaps(s, 0), posefuse::invalid_argument);
   // The reader's other checks still apply.
   const auto back = dir.write("back.csv", "0,0,0,0,0,0,9.81\n5,0,0,0,0,0,nan\n");
-  CHECK_THAT(error_of([&] { (void)posefuse::read_euroc_imu_checked(back, 20'000'000); }),
+  CHECK_THAT(io_error_of([&] { (void)posefuse::read_euroc_imu_checked(back, 20'000'000); }),
              Catch::Contains("back.csv:2: non-finite value 'nan'"));
 }
 
@@ -144,6 +133,6 @@ TEST_CASE("IMU gaps: the real V1_01_easy IMU has none above 20 ms", "[vio][imu][
   // Its intervals are 5 ms to within a microsecond: a 5.001 ms limit passes, 4.999 ms does not.
   CHECK(posefuse::find_imu_gaps(s, 5'001'000).empty());
   CHECK(posefuse::find_imu_gaps(s, 4'999'000).size() > 29000);
-  CHECK_THAT(error_of([&] { (void)posefuse::read_euroc_imu_checked(d / "imu0.csv", 4'999'000); }),
+  CHECK_THAT(io_error_of([&] { (void)posefuse::read_euroc_imu_checked(d / "imu0.csv", 4'999'000); }),
              Catch::Contains("imu0.csv:3: gap of "));
 }
