@@ -128,7 +128,6 @@ class SpdSolver {
   using Inverse = std::conditional_t<kClosedForm, Mat, Empty>;
   using Factor = std::conditional_t<kClosedForm, Empty, Mat>;
   using InvDiag = std::conditional_t<kClosedForm, Empty, Vec>;
-  using Recip = std::conditional_t<kClosedForm, T, Empty>;
   template <class Member>
   static Member zero() {
     if constexpr (std::is_same_v<Member, Empty>) {
@@ -140,7 +139,7 @@ class SpdSolver {
     }
   }
   [[no_unique_address]] Inverse inv_ = zero<Inverse>();     // S^-1 (sizes 1 and 2)
-  [[no_unique_address]] Recip recip_ = zero<Recip>();       // 1 / det S (sizes 1 and 2)
+  T recip_ = T(0);  // 1 / det S (sizes 1 and 2)
   [[no_unique_address]] Factor L_ = zero<Factor>();         // unit lower triangular L
   [[no_unique_address]] Factor LD_ = zero<Factor>();        // L_ij d_j (i > j)
   [[no_unique_address]] InvDiag inv_diag_ = zero<InvDiag>();  // 1 / d_j

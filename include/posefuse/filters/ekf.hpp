@@ -71,6 +71,7 @@
 namespace posefuse {
 
 namespace detail {
+/// The index of T in Ts..., or sizeof...(Ts) unless T occurs exactly once.
 template <class T, class... Ts>
 inline constexpr std::size_t index_of_v = [] {
   constexpr std::array<bool, sizeof...(Ts)> same{std::is_same_v<T, Ts>...};
@@ -105,6 +106,7 @@ consteval bool state_matches() {
     return true;
   }
 }
+
 /// Placeholder measurement type for update_with() with a type that names none.
 struct NotAMeasurementModel {};
 template <class H>

@@ -392,7 +392,20 @@ template <class Options, class H, class Gate>
   }
   if (!gate_accepts<H>(gate, out)) return out;
   out.status = FilterStatus::kNonFinite;
-  const StateType x_new = posefuse::plus(x, TangentOf<StateType>(g.K * out.innovation));
+  TangentOf<StateType> dx;  // K r
+  if constexpr (EkfGain<H>::M <= 2) {
+    // Row by row on scalars (the sums Eigen's product forms for one or two
+    // columns): closed_form_selection_gain() writes K entry by entry, and
+    // reading it back in pairs stalls store-to-load forwarding.
+    for (int i = 0; i < EkfGain<H>::Dim; ++i) {
+      ScalarOf<StateType> v = g.K(i, 0) * out.innovation(0);
+      if constexpr (EkfGain<H>::M == 2) v += g.K(i, 1) * out.innovation(1);
+      dx(i) = v;
+    }
+  } else {
+    dx = g.K * out.innovation;
+  }
+  const StateType x_new = posefuse::plus(x, dx);
   if (!all_entries_finite(posefuse::minus(x_new, x))) return out;
   x = x_new;
   P = g.P_post;
