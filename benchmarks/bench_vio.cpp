@@ -26,7 +26,8 @@
 //                             the same residuals: the prior r0 + J (x - x̄)
 //                             with Jacobian J, the whitened IMU factor
 //                             (ImuFactor::whitened_residual) and the
-//                             reprojection factor with Ceres's CauchyLoss(1),
+//                             reprojection factor with Ceres's CauchyLoss at the
+//                             window's loss scale (√2 σ by default),
 //                             which scales residual and Jacobian by √ρ′ as
 //                             posefuse does (ρ″ ≤ 0); an observation nearer
 //                             than 0.05 m to its camera contributes zero in both
