@@ -77,24 +77,30 @@ inline int triangulate_features(VioWindow& w, const SlidingWindowOptions& o) {
   return n;
 }
 
-/// The keyframe test of the file comment for the frame at `slot` against `slot - 1`.
-[[nodiscard]] inline bool is_keyframe(const VioWindow& w, std::size_t slot, const SlidingWindowOptions& o) {
-  if (slot == 0) return true;
-  const std::uint64_t a = w.frames[slot - 1].id, b = w.frames[slot].id;
-  double sum = 0.0;
-  int shared = 0;
+/// Calls f(|m_a - m_b|) (normalised coordinates) for every landmark seen in
+/// both frames `a` and `b`, in the window's landmark order.
+template <class F>
+void for_each_shared_displacement(const VioWindow& w, std::uint64_t a, std::uint64_t b, F f) {
   for (const auto& [id, l] : w.landmarks) {
     const VioObservation* oa = nullptr;
     const VioObservation* ob = nullptr;
-    for (const VioObservation& ob_ : l.obs) {
-      if (ob_.frame_id == a) oa = &ob_;
-      if (ob_.frame_id == b) ob = &ob_;
+    for (const VioObservation& o : l.obs) {
+      if (o.frame_id == a) oa = &o;
+      if (o.frame_id == b) ob = &o;
     }
-    if (oa && ob) {
-      sum += (oa->m - ob->m).norm();
-      ++shared;
-    }
+    if (oa && ob) f((oa->m - ob->m).norm());
   }
+}
+
+/// The keyframe test of the file comment for the frame at `slot` against `slot - 1`.
+[[nodiscard]] inline bool is_keyframe(const VioWindow& w, std::size_t slot, const SlidingWindowOptions& o) {
+  if (slot == 0) return true;
+  double sum = 0.0;
+  int shared = 0;
+  for_each_shared_displacement(w, w.frames[slot - 1].id, w.frames[slot].id, [&](double d) {
+    sum += d;
+    ++shared;
+  });
   if (shared < o.min_tracked) return true;
   return sum / shared * o.focal_px >= o.min_parallax_px;
 }
@@ -109,17 +115,9 @@ inline int triangulate_features(VioWindow& w, const SlidingWindowOptions& o) {
 [[nodiscard]] inline bool is_stationary(const VioWindow& w, std::size_t ref, std::size_t slot,
                                         const SlidingWindowOptions& o) {
   if (ref >= slot || slot >= w.frames.size()) return false;
-  const std::uint64_t a = w.frames[ref].id, b = w.frames[slot].id;
   std::vector<double> d;
-  for (const auto& [id, l] : w.landmarks) {
-    const VioObservation* oa = nullptr;
-    const VioObservation* ob = nullptr;
-    for (const VioObservation& ob_ : l.obs) {
-      if (ob_.frame_id == a) oa = &ob_;
-      if (ob_.frame_id == b) ob = &ob_;
-    }
-    if (oa && ob) d.push_back((oa->m - ob->m).norm() * o.focal_px);
-  }
+  for_each_shared_displacement(w, w.frames[ref].id, w.frames[slot].id,
+                               [&](double m) { d.push_back(m * o.focal_px); });
   if (int(d.size()) < o.min_tracked) return false;
   const auto mid = d.begin() + std::ptrdiff_t(d.size() / 2);
   std::nth_element(d.begin(), mid, d.end());
