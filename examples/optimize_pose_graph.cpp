@@ -330,14 +330,7 @@ int run(const Options& o) {
     std::snprintf(buf, sizeof buf, "solving: %zu nodes, %zu edges, cost %.6g", graph.num_nodes(),
                   graph.num_edges(), init_cost);
     progress.stage(buf);
-    solver.progress = [&progress, max = o.solver.max_iterations](const PoseGraphIteration& it) {
-      progress.update([&] {
-        char line[160];
-        std::snprintf(line, sizeof line, "iteration %d/%d  cost %.6g  step %.3g%s", it.iteration, max, it.cost,
-                      it.step_norm, it.accepted ? "" : " (rejected)");
-        return std::string(line);
-      });
-    };
+    solver.progress = apps::solver_progress<PoseGraphIteration>(progress, o.solver.max_iterations);
   }
   const PoseGraphSummary s = graph.optimize(solver);
   progress.clear();

@@ -65,4 +65,18 @@ class TerminalProgress {
   std::chrono::steady_clock::time_point last_{};
 };
 
+/// A pose-graph solver callback that shows each iteration (iteration of
+/// `max_iterations`, cost, step; rejected steps marked) on `progress`.
+template <class Iteration>
+auto solver_progress(TerminalProgress& progress, int max_iterations) {
+  return [&progress, max_iterations](const Iteration& it) {
+    progress.update([&] {
+      char line[160];
+      std::snprintf(line, sizeof line, "iteration %d/%d  cost %.6g  step %.3g%s", it.iteration, max_iterations,
+                    it.cost, it.step_norm, it.accepted ? "" : " (rejected)");
+      return std::string(line);
+    });
+  };
+}
+
 }  // namespace posefuse::apps
