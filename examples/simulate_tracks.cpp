@@ -86,6 +86,9 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
             .unit = "s"},
            c.max_pose_gap_s, apps::Domain::kPositive);
   cli.integer({.name = "--seed", .value = "N", .help = "random seed"}, c.seed);
+  cli.flag({.name = "--recurring-ids",
+            .help = "a landmark keeps its id when seen again (an oracle for\nloop closure: perfect re-identification)"},
+           c.recurring_ids);
   cli.real({.name = "--duration", .value = "S", .help = "synthetic flight length", .unit = "s"}, o.duration_s,
            apps::Domain::kPositive);
   cli.path({.name = "--groundtruth-out", .value = "FILE",

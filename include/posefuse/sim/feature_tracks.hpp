@@ -27,6 +27,11 @@
 /// end's detection mask); a track gets the next id (0, 1, 2, ...) with its
 /// first written observation: ids are never reused (a landmark seen again
 /// after its track ended gets a new id) and every id appears in the output.
+/// With `recurring_ids` a track's id is instead its landmark's index, so a
+/// landmark seen again, seconds or minutes later, comes back under the same
+/// id: the data association a place-recognition front end would find, given
+/// here by the simulation itself (an oracle: perfect, with no false matches
+/// beyond the wrong associations below).
 ///
 /// **Observations.** Each observation is, with probability
 /// `outlier_fraction` and independently of the others, a **wrong
@@ -86,6 +91,9 @@ struct TrackSimConfig {
   /// longer than this are refused (s); for simulate_feature_tracks(EurocGroundTruth).
   double max_pose_gap_s = 0.1;
   std::uint64_t seed = 1;               ///< random seed
+  /// A landmark keeps its id (its index) whenever it is seen again: loop
+  /// closures by an oracle (file comment). Off: every track gets a new id.
+  bool recurring_ids = false;
 
   /// @throws posefuse::invalid_argument naming the first bad parameter
   void validate() const {
@@ -127,7 +135,9 @@ struct SimulatedTracks {
   std::vector<Eigen::Isometry3d> T_W_B;       ///< body pose at each frame
   std::vector<Eigen::Vector3d> landmarks_w;   ///< landmarks: walls first, then free points (m)
   std::size_t wall_landmarks = 0;             ///< landmarks_w[0, wall_landmarks) lie on walls
-  std::vector<std::size_t> landmark_of_id;    ///< landmark_of_id[id]: the landmark of track id (one per track)
+  /// landmark_of_id[id]: the landmark of track id (one per track; with
+  /// recurring_ids the identity over every landmark, as ids are landmarks)
+  std::vector<std::size_t> landmark_of_id;
   std::size_t observations = 0;               ///< observations written
   std::size_t wrong_associations = 0;         ///< of which wrong associations
   std::size_t frames_below_target = 0;        ///< frames with fewer than features_per_frame features
@@ -181,6 +191,8 @@ struct SimulatedTracks {
     int length, limit;
   };
   const std::size_t L = out.landmarks_w.size();
+  if (config.recurring_ids)
+    for (std::size_t i = 0; i < L; ++i) out.landmark_of_id.push_back(i);
   std::vector<Eigen::Vector2d> proj(L);
   std::vector<char> seen(L, 0), tracked(L, 0);
   std::vector<std::size_t> visible, candidates;
@@ -281,8 +293,12 @@ struct SimulatedTracks {
         continue;
       }
       if (t.length == 0) {
-        t.id = std::uint64_t(out.landmark_of_id.size());
-        out.landmark_of_id.push_back(t.landmark);
+        if (config.recurring_ids) {
+          t.id = std::uint64_t(t.landmark);
+        } else {
+          t.id = std::uint64_t(out.landmark_of_id.size());
+          out.landmark_of_id.push_back(t.landmark);
+        }
       }
       ++t.length;
       frame.features.push_back(FeatureObservation{t.id, uv});

@@ -31,6 +31,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -38,6 +39,7 @@
 #include <posefuse/inertial/preintegration.hpp>
 #include <posefuse/vio/camera.hpp>
 #include <posefuse/vio/feature_tracks.hpp>
+#include <posefuse/vio/keyframe_record.hpp>
 #include <posefuse/vio/sliding_window.hpp>
 #include <posefuse/vio/static_initialization.hpp>
 
@@ -54,6 +56,23 @@ enum class VioStatus { kInitializing, kTracking, kNotEnoughFeatures, kDegenerate
     case VioStatus::kNotEnoughFeatures: return "not enough features";
     case VioStatus::kDegenerate: return "degenerate";
     case VioStatus::kReset: return "reset";
+  }
+  return "unknown";
+}
+
+/// How the estimator starts (see the file comment).
+enum class VioStart {
+  kAuto,     ///< static when the sequence begins at rest, dynamic otherwise
+  kStatic,   ///< only at rest
+  kDynamic,  ///< only from structure from motion + visual-inertial alignment
+};
+
+/// Name of a VioStart ("auto", "static", "dynamic").
+[[nodiscard]] constexpr const char* to_string(VioStart s) noexcept {
+  switch (s) {
+    case VioStart::kAuto: return "auto";
+    case VioStart::kStatic: return "static";
+    case VioStart::kDynamic: return "dynamic";
   }
   return "unknown";
 }
@@ -75,6 +94,7 @@ struct VioEstimatorOptions {
   PreintegrationOptions preintegration; ///< gap limit, re-propagation thresholds
   StaticInitOptions static_init;        ///< static start
   VioInitialSigma initial_sigma;        ///< prior on the first frame
+  VioStart start = VioStart::kAuto;     ///< how to start without an explicit initial state
   int min_features = 10;                ///< below this a frame is kNotEnoughFeatures
   double max_speed_mps = 50.0;          ///< above this the window is reset
 };
@@ -87,6 +107,9 @@ struct VioFrameResult {
   int features = 0;                          ///< triangulated features seen in the frame
   int iterations = 0;                        ///< LM trials of its solve
   std::string message;                       ///< why initializing, when it is
+  /// Set when a keyframe left the window with this frame (its pose and
+  /// triangulated features are then final for the odometry).
+  std::optional<KeyframeRecord> keyframe;
 };
 
 /// The estimator (see the file comment).
@@ -181,8 +204,12 @@ class VioEstimator {
     res.state = w_.frames.back().x;
     if (res.status != VioStatus::kDegenerate) last_good_ = res.state;
     if (int(w_.frames.size()) > o_.window.window_size) {
-      if (is_keyframe(w_, w_.frames.size() - 2, o_.window)) marginalize_oldest(w_, o_.window, problem_);
-      else drop_second_newest(w_);
+      if (is_keyframe(w_, w_.frames.size() - 2, o_.window)) {
+        res.keyframe = record_oldest();
+        marginalize_oldest(w_, o_.window, problem_);
+      } else {
+        drop_second_newest(w_);
+      }
     }
     trim_imu();
     return res;
@@ -237,6 +264,30 @@ class VioEstimator {
       if (!m.allFinite()) continue;
       w_.landmarks[ob.id].obs.push_back(VioObservation{fid, m});
     }
+  }
+
+  // The oldest keyframe with its features, before it is marginalised.
+  [[nodiscard]] KeyframeRecord record_oldest() const {
+    const VioFrame& f = w_.frames.front();
+    KeyframeRecord r;
+    r.t_ns = f.t_ns;
+    r.T_w_b = SE3d(f.x.p, f.x.R);
+    r.T_b_c = SE3d(w_.T_bc.p, w_.T_bc.R);
+    for (const auto& [id, l] : w_.landmarks) {
+      for (const VioObservation& ob : l.obs) {
+        if (ob.frame_id != f.id) continue;
+        KeyframeFeature kf;
+        kf.id = id;
+        kf.m = ob.m;
+        if (l.initialised && l.obs.size() >= 2) {
+          kf.p_w = landmark_world_point(w_, l);
+          kf.has_point = kf.p_w.allFinite();
+        }
+        r.features.push_back(kf);
+        break;
+      }
+    }
+    return r;
   }
 
   [[nodiscard]] int features_in_newest() const {
