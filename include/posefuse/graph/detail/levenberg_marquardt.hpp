@@ -78,8 +78,8 @@ template <int B>
 /// Solves \f$ (H + \lambda\,\mathrm{diag}(H)) \Delta = -b \f$ into w.dx (H
 /// is left undamped; w.diag holds diag(H)).
 /// @return false when the damped H is not positive definite or Δ is not finite
-template <int B>
-[[nodiscard]] bool solve_damped(SolverBuffers<B>& w, double lambda) {
+template <class Buffers>
+[[nodiscard]] bool solve_damped(Buffers& w, double lambda) {
   if (lambda > 0) {
     w.delta.resize(w.diag.size());
     for (Eigen::Index c = 0; c < w.diag.size(); ++c) w.delta(c) = lambda * std::clamp(w.diag(c), 1e-6, 1e32);
@@ -96,8 +96,14 @@ template <int B>
 
 /// Minimises the cost from the state w.x (left at the solution), on the
 /// layout L. Fills every field of the summary but the time and `planar`.
-template <int B>
-[[nodiscard]] PoseGraphSummary levenberg_marquardt(PoseGraphAssembly<B>& f, SolverBuffers<B>& w,
+///
+/// `Assembly` gives cost(x), num_edges(), linearize(x) (into w.sys) and
+/// set_trigonometry(x) (the per-node quantities linearize() reads);
+/// `Buffers` holds sys, chol, x, trial, diag, delta and dx (SolverBuffers<B>
+/// for the 4-DoF graph, SolverBuffersSE3 for the SE(3) one). apply_step<B>
+/// and step_below_tolerance<B> are found for the state type of w.x.
+template <int B, class Assembly, class Buffers>
+[[nodiscard]] PoseGraphSummary levenberg_marquardt(Assembly& f, Buffers& w,
                                                    const PoseGraphLayout& L, const PoseGraphOptions& options) {
   PoseGraphSummary s;
   s.initial_cost = s.final_cost = f.cost(w.x);  // leaves the trigonometry at w.x
