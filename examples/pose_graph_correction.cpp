@@ -1,10 +1,12 @@
 // pose_graph_correction: corrects a drifting odometry trajectory with loop
 // closures on posefuse's 4-DoF pose graph (VINS-Mono's global pose graph,
-// seed 003, docs/pose-graph.md) and compares the absolute position error before and
-// after.
+// seed 003, docs/pose-graph.md) or, with --dof 6, on its SE(3) pose graph,
+// and compares the absolute position error before and after.
 //
 // Scenario: a visual(-inertial) odometry ran; its trajectory drifts in x, y,
-// z and yaw (roll and pitch are observable from gravity and held fixed).
+// z and yaw (roll and pitch are observable from gravity and held fixed: the
+// 4-DoF graph, the default). A visual-only odometry drifts in roll and
+// pitch too: --dof 6 lets the graph move all six directions.
 // Sequential edges are the odometry's relative motions; loop edges come from
 // a file (posefuse's 4-DoF loop-edge format, node ids = pose indices) or,
 // with --oracle-loops, from ground-truth revisits: an ORACLE for evaluating
@@ -27,6 +29,8 @@
 //
 //   pose_graph_correction --odometry cvo_vo.txt --groundtruth groundtruth.txt
 //       --oracle-loops --outliers 10 --out corrected.txt --svg kitti06_graph.svg
+//   pose_graph_correction --odometry cvo_vo.txt --groundtruth groundtruth.txt
+//       --oracle-loops --dof 6
 //
 // Exit status 0 ok, 1 bad data (one line on stderr, file:line where a file
 // is at fault), 2 bad usage. --out and --svg are written only when
@@ -51,6 +55,7 @@
 #include <posefuse/eval/alignment.hpp>
 #include <posefuse/eval/metrics.hpp>
 #include <posefuse/graph/pose_graph_4dof.hpp>
+#include <posefuse/graph/pose_graph_se3.hpp>
 #include <posefuse/io/formats.hpp>
 #include <posefuse/io/g2o.hpp>
 #include <posefuse/lie/rotation.hpp>
@@ -70,6 +75,7 @@ struct Options {
   double sigma_odo_p = 0.1, sigma_odo_yaw_deg = 0.5;
   double sigma_loop_p = 0.1, sigma_loop_yaw_deg = 0.5;
   bool json = false;
+  int dof = 4;  ///< 4: PoseGraph4Dof, 6: PoseGraphSE3
 };
 
 std::optional<Options> parse_options(const apps::CommandLine& cmd) {
@@ -110,8 +116,18 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
            apps::Domain::kPositive);
   cli.path({.name = "--out", .value = "FILE", .help = "write the corrected trajectory (input format)"}, o.out);
   cli.path({.name = "--svg", .value = "FILE.svg", .help = "top view: truth, before, after, loop edges"}, o.svg);
+  cli.custom({.name = "--dof", .value = "4|6",
+              .help = "4: x, y, z, yaw (roll and pitch held, visual-inertial odometry);\n"
+                      "6: SE(3), every direction free (visual-only odometry)",
+              .default_text = "4"},
+             [&](std::string_view v) {
+               if (v == "4") o.dof = 4;
+               else if (v == "6") o.dof = 6;
+               else throw apps::usage_error("expected 4 or 6, got '" + std::string(v) + "'");
+             });
   cli.flag({.name = "--json", .help = "print the results as JSON instead of a table"}, o.json);
-  cli.epilogue("Odometry edges: 0.1 m, 0.5 deg (1 sigma) per frame; loop edges 0.1 m, 0.5 deg.\n"
+  cli.epilogue("Odometry edges: 0.1 m, 0.5 deg (1 sigma, about every rotation axis with --dof 6) per frame;\n"
+               "loop edges 0.1 m, 0.5 deg.\n"
                "Exit status: 0 ok, 1 bad data (one line on stderr, file:line where a file is at fault),\n"
                "2 bad usage.");
   if (!cli.parse(cmd)) return std::nullopt;
@@ -120,6 +136,8 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   if (o.odometry && !o.loops && !o.oracle) throw apps::usage_error("give --loops FILE or --oracle-loops");
   if (!o.odometry && (o.loops || o.oracle)) throw apps::usage_error("--loops and --oracle-loops need --odometry");
   if (o.up.empty()) o.up = o.format == Format::kKitti ? "-y" : "z";
+  if (o.dof == 6 && o.loops)
+    throw apps::usage_error("--loops holds 4-DoF edges (no roll or pitch); with --dof 6 use --oracle-loops");
   if (cli.given("--robust-scale") && o.loss.type == RobustLoss::kNone)
     throw apps::usage_error("--robust-scale needs a robust loss (--robust huber|cauchy)");
   {
@@ -281,6 +299,67 @@ std::string plot(const Trajectory& truth, const Trajectory& before, const Trajec
   return doc.str();
 }
 
+SE3d to_se3(const Eigen::Isometry3d& T) {
+  return SE3d(T.translation(), SO3d(Eigen::Quaterniond(T.linear())));
+}
+
+/// The SE(3) information of a measurement with sigma_p (m) per axis and
+/// sigma_r (rad) about every axis: the error's quaternion part is half the
+/// rotation angle, hence 4 / sigma_r^2.
+Matrix6d information_se3(double sp, double sr) {
+  Matrix6d I = Matrix6d::Zero();
+  I.diagonal() << Eigen::Vector3d::Constant(1 / (sp * sp)), Eigen::Vector3d::Constant(4 / (sr * sr));
+  return I;
+}
+
+/// --dof 6: the SE(3) graph of the odometry (relative motions), the loop
+/// edges' node pairs measured from the truth (the oracle's, or the
+/// simulator's) and the outliers (identity measurements); returns the
+/// corrected poses.
+PoseGraphSummary correct_se3(const Options& o, const Trajectory& odo_up, const Trajectory& truth_up,
+                             const std::vector<Edge4Dof>& loops, std::size_t first_outlier, const std::string& name,
+                             apps::TerminalProgress& progress, Trajectory& after_up) {
+  PoseGraphSE3 graph;
+  const double deg = std::numbers::pi / 180;
+  try {
+    for (std::size_t k = 0; k < odo_up.size(); ++k)
+      graph.add_node(static_cast<std::int64_t>(k), to_se3(odo_up.poses[k]), k == 0);
+    const Matrix6d odo_info = information_se3(o.sigma_odo_p, o.sigma_odo_yaw_deg * deg);
+    const Matrix6d loop_info = information_se3(o.sigma_loop_p, o.sigma_loop_yaw_deg * deg);
+    for (std::size_t k = 0; k + 1 < odo_up.size(); ++k) {
+      EdgeSE3 e;
+      e.from = static_cast<std::int64_t>(k);
+      e.to = static_cast<std::int64_t>(k + 1);
+      e.measurement = to_se3(odo_up.poses[k]).inverse() * to_se3(odo_up.poses[k + 1]);
+      e.information = odo_info;
+      graph.add_edge(e);
+    }
+    for (std::size_t k = 0; k < loops.size(); ++k) {
+      EdgeSE3 e;
+      e.from = loops[k].from;
+      e.to = loops[k].to;
+      if (k < first_outlier)
+        e.measurement = to_se3(truth_up.poses[std::size_t(e.from)]).inverse() * to_se3(truth_up.poses[std::size_t(e.to)]);
+      e.information = loop_info;
+      e.loss = o.loss;
+      graph.add_edge(e);
+    }
+  } catch (const posefuse::invalid_argument& e) {
+    throw apps::data_error(name + ": " + e.what());
+  }
+  PoseGraphOptions solver;
+  if (progress.enabled()) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "solving (SE(3)): %zu nodes, %zu edges", graph.num_nodes(), graph.num_edges());
+    progress.stage(buf);
+    solver.progress = apps::solver_progress<PoseGraphIteration>(progress, solver.max_iterations);
+  }
+  const PoseGraphSummary s = graph.optimize(solver);
+  after_up = odo_up;
+  for (std::size_t k = 0; k < after_up.size(); ++k) after_up.poses[k] = graph.poses()[k].isometry();
+  return s;
+}
+
 int run(const Options& o) {
   // On a terminal, standard error shows the stage and the solver's iterations.
   apps::TerminalProgress progress("pose_graph_correction");
@@ -336,6 +415,11 @@ int run(const Options& o) {
   const std::size_t good_loops = loops.size();
   for (const Edge4Dof& e : outlier_loops(truth_up, outliers, o.seed, loop_info)) loops.push_back(e);
 
+  Trajectory after_up;
+  PoseGraphSummary s;
+  if (o.dof == 6) {
+    s = correct_se3(o, odo_up, truth_up, loops, first_outlier, name, progress, after_up);
+  } else {
   PoseGraph4Dof graph;
   try {
     for (std::size_t k = 0; k < odo_up.size(); ++k)
@@ -361,10 +445,11 @@ int run(const Options& o) {
     progress.stage(buf);
     solver.progress = apps::solver_progress<PoseGraphIteration>(progress, solver.max_iterations);
   }
-  const PoseGraphSummary s = graph.optimize(solver);
-  progress.clear();
-  Trajectory after_up = odo_up;
+  s = graph.optimize(solver);
+  after_up = odo_up;
   for (std::size_t k = 0; k < after_up.size(); ++k) after_up.poses[k] = to_isometry(graph.poses()[k]);
+  }
+  progress.clear();
   const Ape before = ape_of(truth_up, odo_up);
   const Ape after = ape_of(truth_up, after_up);
   for (const double v : {before.se3, before.posyaw, after.se3, after.posyaw, s.final_cost})
@@ -389,7 +474,7 @@ int run(const Options& o) {
     j.member("input", name).member("frames", odo_up.size()).member("loops", good_loops);
     j.member("loop_source", std::string(o.odometry ? (o.oracle ? "oracle (ground-truth revisits)" : "file")
                                                    : "simulator"));
-    j.member("outliers", static_cast<std::size_t>(outliers));
+    j.member("outliers", static_cast<std::size_t>(outliers)).member("dof", o.dof);
     j.key("ape_before").begin_object(Layout::kInline).member("se3", before.se3).member("posyaw", before.posyaw).end_object();
     j.key("ape_after").begin_object(Layout::kInline).member("se3", after.se3).member("posyaw", after.posyaw).end_object();
     j.member("initial_cost", s.initial_cost).member("final_cost", s.final_cost);
@@ -397,6 +482,8 @@ int run(const Options& o) {
     j.end_object().finish();
   } else {
     std::printf("APE = position RMSE [m] against ground truth after SE(3) or 4-DoF (position + yaw) alignment.\n");
+    std::printf("Pose graph: %s.\n", o.dof == 6 ? "6-DoF (SE(3): every direction free, --dof 6)"
+                                                 : "4-DoF (x, y, z, yaw; roll and pitch held, --dof 4)");
     if (o.oracle) std::printf("Loop edges: ORACLE from ground-truth revisits (evaluates the optimiser, not a detector).\n");
     std::printf("\n%-22s %7s %6s %9s %15s %9s %18s %9s %11s %12s\n", "input", "frames", "loops", "outliers",
                 "APE se3 before", "after", "APE posyaw before", "after", "iterations", "solve_time_s");

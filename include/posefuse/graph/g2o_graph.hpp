@@ -1,6 +1,7 @@
 #pragma once
 /// @file
-/// Planar g2o graphs (io/g2o.hpp) as 4-DoF pose graphs and back.
+/// Planar g2o graphs (io/g2o.hpp) as 4-DoF pose graphs, 3-D ones
+/// (io/g2o_se3.hpp) as SE(3) pose graphs, and back.
 ///
 /// A planar graph is the 4-DoF graph with z = 0 and roll = pitch = 0: an
 /// `EDGE_SE2` (dx, dy, dθ, Ω₃ in the order x, y, θ) becomes an Edge4Dof with
@@ -15,7 +16,9 @@
 #include <vector>
 
 #include <posefuse/graph/pose_graph_4dof.hpp>
+#include <posefuse/graph/pose_graph_se3.hpp>
 #include <posefuse/io/g2o.hpp>
+#include <posefuse/io/g2o_se3.hpp>
 
 namespace posefuse {
 
@@ -64,6 +67,40 @@ template <class Lazy = void>
     v.x = x.p.x();
     v.y = x.p.y();
     v.theta = x.yaw;
+  }
+  return g;
+}
+
+/// The SE(3) pose graph of a 3-D g2o graph (`FIX` ids held fixed; with
+/// none, optimize() holds the first vertex). Its cost is g2o's χ².
+/// @param[in] loss robust loss given to every edge
+/// @throws posefuse::invalid_argument as PoseGraphSE3::add_node / add_edge
+template <class Lazy = void>
+[[nodiscard]] PoseGraphSE3 pose_graph_from_g2o(const G2oGraph3d& g, const RobustKernel& loss = {}) {
+  PoseGraphSE3 graph;
+  graph.reserve(g.vertices.size(), g.edges.size());
+  for (const G2oVertexSE3& v : g.vertices) graph.add_node(v.id, SE3d(v.t, SO3d(v.q)));
+  for (const std::int64_t id : g.fixed) graph.set_fixed(id);
+  for (const G2oEdgeSE3& e : g.edges) {
+    EdgeSE3 ed;
+    ed.from = e.from;
+    ed.to = e.to;
+    ed.measurement = SE3d(e.t, SO3d(e.q));
+    ed.information = e.information;
+    ed.loss = loss;
+    graph.add_edge(ed);
+  }
+  return graph;
+}
+
+/// `g` with every vertex moved to the graph's pose of the same id.
+/// @throws posefuse::invalid_argument when a vertex id is not in the graph
+template <class Lazy = void>
+[[nodiscard]] G2oGraph3d with_graph_poses(G2oGraph3d g, const PoseGraphSE3& graph) {
+  for (G2oVertexSE3& v : g.vertices) {
+    const SE3d& x = graph.pose(v.id);
+    v.t = x.translation();
+    v.q = x.so3().quaternion();
   }
   return g;
 }
