@@ -47,6 +47,31 @@
 //                                posefuse's rotation-first poses (computed
 //                                once, outside the timing)
 //
+// 6-DoF (SE(3)) pose graphs, g2o's EdgeSE3 error [t; q_xyz] of Z⁻¹ X_i⁻¹ X_j
+// (include/posefuse/graph/edge_error_se3.hpp) in both solvers, on the seeded
+// problems of include/posefuse/sim/pose_graph_se3.hpp (laps of a banked,
+// climbing track, odometry + a loop edge on every 4th pose) and on
+// parking-garage.g2o:
+//
+//   BM_PoseGraphSE3/posefuse/N   build the graph + PoseGraphSE3::optimize()
+//                                from the chained odometry (LM, function
+//                                tolerance 1e-10)
+//   BM_PoseGraphSE3/posefuse_chordal/N  the same after initialize_chordal()
+//                                (the start is inside the timing)
+//   BM_PoseGraphSE3/ceres/N      build a ceres::Problem + Solve from the
+//                                odometry: one position block and one
+//                                quaternion block (EigenQuaternionManifold)
+//                                per pose, the same residual by automatic
+//                                differentiation, LM, SPARSE_NORMAL_CHOLESKY,
+//                                function tolerance 1e-10, at most 100
+//                                iterations, one thread
+//   BM_PoseGraphSE3/ceres_chordal/N  the same Ceres solve from posefuse's
+//                                chordal poses (computed once, outside the
+//                                timing)
+//   BM_G2o3d/posefuse_file, posefuse_chordal, ceres_file, ceres_chordal
+//                                the same four on parking-garage.g2o (parsed
+//                                once, outside the timing)
+//
 // The files are found as $POSEFUSE_DATA_DIR/posegraph, else in the data
 // folder configured at build time (the CMake cache variable
 // POSEFUSE_DATA_DIR); without them those rows stop with "SKIPPED: ...".
@@ -74,10 +99,14 @@
 #include <posefuse/sim/pose_graph_4dof.hpp>
 #include <posefuse/graph/g2o_graph.hpp>
 #include <posefuse/graph/pose_graph_4dof.hpp>
+#include <posefuse/graph/pose_graph_se3.hpp>
 #include <posefuse/io/g2o.hpp>
+#include <posefuse/io/g2o_se3.hpp>
+#include <posefuse/sim/pose_graph_se3.hpp>
 
 #ifdef POSEFUSE_HAVE_CERES
 #include <ceres/ceres.h>
+#include <ceres/manifold.h>
 #endif
 
 namespace {
@@ -181,6 +210,83 @@ void BM_G2o_posefuse_4dof(benchmark::State& state) { run_g2o_posefuse(state, fal
 // Arg 0 = Manhattan 3500, 1 = MIT Killian Court.
 BENCHMARK(BM_G2o_posefuse)->Name("BM_G2o/posefuse")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_G2o_posefuse_4dof)->Name("BM_G2o/posefuse_4dof")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+const sim::PoseGraphProblemSE3& problem_se3(int n) {
+  static std::map<int, sim::PoseGraphProblemSE3> cache;
+  auto it = cache.find(n);
+  if (it == cache.end()) {
+    sim::PoseGraphProblemSE3Config c;
+    c.nodes = n;
+    c.seed = 42;
+    it = cache.emplace(n, sim::make_pose_graph_problem_se3(c)).first;
+  }
+  return it->second;
+}
+
+void run_se3_posefuse(benchmark::State& state, bool chordal) {
+  const sim::PoseGraphProblemSE3& pr = problem_se3(static_cast<int>(state.range(0)));
+  PoseGraphSummary s;
+  for (auto _ : state) {
+    PoseGraphSE3 g = sim::to_pose_graph_se3(pr);
+    if (chordal) g.initialize_chordal();
+    s = g.optimize();
+    benchmark::DoNotOptimize(s);
+  }
+  state.counters["chi2"] = s.final_cost;
+  state.counters["iterations"] = s.iterations;
+}
+void BM_PoseGraphSE3_posefuse(benchmark::State& state) { run_se3_posefuse(state, false); }
+void BM_PoseGraphSE3_posefuse_chordal(benchmark::State& state) { run_se3_posefuse(state, true); }
+BENCHMARK(BM_PoseGraphSE3_posefuse)
+    ->Name("BM_PoseGraphSE3/posefuse")
+    ->Arg(1000)->Arg(10000)->Arg(100000)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PoseGraphSE3_posefuse_chordal)
+    ->Name("BM_PoseGraphSE3/posefuse_chordal")
+    ->Arg(1000)->Arg(10000)->Arg(100000)
+    ->Unit(benchmark::kMillisecond);
+
+/// parking-garage.g2o, parsed once; nullopt when absent.
+const std::optional<G2oGraph3d>& garage() {
+  static const std::optional<G2oGraph3d> g = [] {
+    std::vector<std::filesystem::path> dirs;
+    if (const char* d = std::getenv("POSEFUSE_DATA_DIR"); d != nullptr && *d != '\0') dirs.emplace_back(d);
+#ifdef POSEFUSE_DEFAULT_DATA_DIR
+    dirs.emplace_back(POSEFUSE_DEFAULT_DATA_DIR);
+#endif
+    for (const auto& d : dirs) {
+      const std::filesystem::path p = d / "posegraph" / "parking-garage.g2o";
+      if (std::filesystem::is_regular_file(p)) return std::optional<G2oGraph3d>(read_g2o_3d(p));
+    }
+    return std::optional<G2oGraph3d>();
+  }();
+  return g;
+}
+
+bool skip_without_garage(benchmark::State& state) {
+  if (garage()) return false;
+  state.SkipWithError("SKIPPED: posegraph/parking-garage.g2o not found (set POSEFUSE_DATA_DIR to the folder "
+                      "holding posegraph/)");
+  return true;
+}
+
+void run_garage_posefuse(benchmark::State& state, bool chordal) {
+  if (skip_without_garage(state)) return;
+  PoseGraphSummary s;
+  for (auto _ : state) {
+    PoseGraphSE3 g = pose_graph_from_g2o(*garage());
+    if (chordal) g.initialize_chordal();
+    s = g.optimize();
+    benchmark::DoNotOptimize(s);
+  }
+  state.counters["chi2"] = s.final_cost;
+  state.counters["iterations"] = s.iterations;
+  state.SetLabel("parking-garage");
+}
+void BM_G2o3d_posefuse_file(benchmark::State& state) { run_garage_posefuse(state, false); }
+void BM_G2o3d_posefuse_chordal(benchmark::State& state) { run_garage_posefuse(state, true); }
+BENCHMARK(BM_G2o3d_posefuse_file)->Name("BM_G2o3d/posefuse_file")->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_G2o3d_posefuse_chordal)->Name("BM_G2o3d/posefuse_chordal")->Unit(benchmark::kMillisecond);
 
 #ifdef POSEFUSE_HAVE_CERES
 
@@ -358,6 +464,121 @@ BENCHMARK(BM_G2o_ceres_rotation_first)
     ->Name("BM_G2o/ceres_rotation_first")
     ->Arg(0)->Arg(1)
     ->Unit(benchmark::kMillisecond);
+
+/// g2o's EdgeSE3 error [t; q_xyz] of Z⁻¹ X_i⁻¹ X_j (q with w >= 0) on a
+/// position block and an Eigen-order quaternion block per pose, whitened
+/// by the information's upper Cholesky factor (for Ceres's autodiff).
+struct EdgeSE3Error {
+  Eigen::Vector3d tz;
+  Eigen::Quaterniond qz_inv;
+  Eigen::Matrix<double, 6, 6> sqrt_info;
+
+  template <class T>
+  bool operator()(const T* ti, const T* qi, const T* tj, const T* qj, T* residual) const {
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> pi(ti), pj(tj);
+    const Eigen::Map<const Eigen::Quaternion<T>> Qi(qi), Qj(qj);
+    const Eigen::Quaternion<T> Qz_inv = qz_inv.template cast<T>();
+    Eigen::Quaternion<T> qe = Qz_inv * (Qi.conjugate() * Qj);
+    const Eigen::Matrix<T, 3, 1> te = Qz_inv * (Qi.conjugate() * (pj - pi) - tz.template cast<T>());
+    if (qe.w() < T(0)) qe.coeffs() = -qe.coeffs();
+    Eigen::Matrix<T, 6, 1> e;
+    e << te, qe.vec();
+    Eigen::Map<Eigen::Matrix<T, 6, 1>> r(residual);
+    r = sqrt_info.template cast<T>() * e;
+    return true;
+  }
+};
+
+/// One pose in Ceres's blocks: position, quaternion (x, y, z, w).
+struct CeresPose {
+  std::array<double, 3> t;
+  std::array<double, 4> q;
+};
+
+CeresPose ceres_pose(const SE3d& x) {
+  const Eigen::Quaterniond& q = x.so3().quaternion();
+  return {{x.translation().x(), x.translation().y(), x.translation().z()}, {q.x(), q.y(), q.z(), q.w()}};
+}
+
+/// Builds and solves the Ceres problem of `edges` from `start` (the first
+/// pose held fixed).
+CeresRun solve_se3_with_ceres(std::vector<CeresPose> x, const std::vector<EdgeSE3>& edges) {
+  ceres::Problem::Options po;
+  po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::EigenQuaternionManifold quaternion;
+  ceres::Problem problem(po);
+  for (const EdgeSE3& e : edges) {
+    const Eigen::Quaterniond& qz = e.measurement.so3().quaternion();
+    EdgeSE3Error f{e.measurement.translation(), qz.conjugate(), e.information.llt().matrixU()};
+    CeresPose& a = x[std::size_t(e.from)];
+    CeresPose& b = x[std::size_t(e.to)];
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<EdgeSE3Error, 6, 3, 4, 3, 4>(new EdgeSE3Error(f)),
+                             nullptr, a.t.data(), a.q.data(), b.t.data(), b.q.data());
+  }
+  for (CeresPose& p : x)
+    if (problem.HasParameterBlock(p.q.data())) problem.SetManifold(p.q.data(), &quaternion);
+  problem.SetParameterBlockConstant(x[0].t.data());
+  problem.SetParameterBlockConstant(x[0].q.data());
+  const CeresRun run = solve_with_ceres(problem);
+  benchmark::DoNotOptimize(x.data());
+  return run;
+}
+
+/// posefuse's chordal start of a graph, as Ceres blocks.
+std::vector<CeresPose> chordal_start(PoseGraphSE3 g) {
+  g.initialize_chordal();
+  std::vector<CeresPose> x;
+  for (const SE3d& p : g.poses()) x.push_back(ceres_pose(p));
+  return x;
+}
+
+void run_se3_ceres(benchmark::State& state, bool chordal) {
+  const sim::PoseGraphProblemSE3& pr = problem_se3(static_cast<int>(state.range(0)));
+  std::vector<CeresPose> start;
+  if (chordal) {
+    start = chordal_start(sim::to_pose_graph_se3(pr));
+  } else {
+    for (const SE3d& p : pr.initial) start.push_back(ceres_pose(p));
+  }
+  CeresRun run{};
+  for (auto _ : state) run = solve_se3_with_ceres(start, pr.edges);
+  report_ceres(state, run, "");
+}
+void BM_PoseGraphSE3_ceres(benchmark::State& state) { run_se3_ceres(state, false); }
+void BM_PoseGraphSE3_ceres_chordal(benchmark::State& state) { run_se3_ceres(state, true); }
+BENCHMARK(BM_PoseGraphSE3_ceres)
+    ->Name("BM_PoseGraphSE3/ceres")
+    ->Arg(1000)->Arg(10000)->Arg(100000)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PoseGraphSE3_ceres_chordal)
+    ->Name("BM_PoseGraphSE3/ceres_chordal")
+    ->Arg(1000)->Arg(10000)->Arg(100000)
+    ->Unit(benchmark::kMillisecond);
+
+void run_garage_ceres(benchmark::State& state, bool chordal) {
+  if (skip_without_garage(state)) return;
+  // The file's ids are 0..n-1 in order (checked), so they index the blocks.
+  const G2oGraph3d& file = *garage();
+  for (std::size_t k = 0; k < file.vertices.size(); ++k)
+    if (file.vertices[k].id != std::int64_t(k)) {
+      state.SkipWithError("parking-garage.g2o: vertex ids are not 0..n-1 in order");
+      return;
+    }
+  const PoseGraphSE3 graph = pose_graph_from_g2o(file);
+  std::vector<CeresPose> start;
+  if (chordal) {
+    start = chordal_start(graph);
+  } else {
+    for (const SE3d& p : graph.poses()) start.push_back(ceres_pose(p));
+  }
+  CeresRun run{};
+  for (auto _ : state) run = solve_se3_with_ceres(start, graph.edges());
+  report_ceres(state, run, "parking-garage");
+}
+void BM_G2o3d_ceres_file(benchmark::State& state) { run_garage_ceres(state, false); }
+void BM_G2o3d_ceres_chordal(benchmark::State& state) { run_garage_ceres(state, true); }
+BENCHMARK(BM_G2o3d_ceres_file)->Name("BM_G2o3d/ceres_file")->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_G2o3d_ceres_chordal)->Name("BM_G2o3d/ceres_chordal")->Unit(benchmark::kMillisecond);
 
 #endif
 
