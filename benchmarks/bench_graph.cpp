@@ -55,7 +55,9 @@
 //
 //   BM_PoseGraphSE3/posefuse/N   build the graph + PoseGraphSE3::optimize()
 //                                from the chained odometry (LM, function
-//                                tolerance 1e-10)
+//                                tolerance 1e-10), with one
+//                                PoseGraphSE3Workspace the program holds for
+//                                all its SE(3) rows, as the 4-DoF rows
 //   BM_PoseGraphSE3/posefuse_chordal/N  the same after initialize_chordal()
 //                                (the start is inside the timing)
 //   BM_PoseGraphSE3/ceres/N      build a ceres::Problem + Solve from the
@@ -223,13 +225,20 @@ const sim::PoseGraphProblemSE3& problem_se3(int n) {
   return it->second;
 }
 
+/// The solver buffers the SE(3) posefuse rows share (see the file comment).
+PoseGraphSE3Workspace& se3_workspace() {
+  static PoseGraphSE3Workspace workspace;
+  return workspace;
+}
+
 void run_se3_posefuse(benchmark::State& state, bool chordal) {
   const sim::PoseGraphProblemSE3& pr = problem_se3(static_cast<int>(state.range(0)));
+  PoseGraphSE3Workspace& workspace = se3_workspace();
   PoseGraphSummary s;
   for (auto _ : state) {
     PoseGraphSE3 g = sim::to_pose_graph_se3(pr);
-    if (chordal) g.initialize_chordal();
-    s = g.optimize();
+    if (chordal) g.initialize_chordal(workspace);
+    s = g.optimize({}, workspace);
     benchmark::DoNotOptimize(s);
   }
   state.counters["chi2"] = s.final_cost;
@@ -272,11 +281,12 @@ bool skip_without_garage(benchmark::State& state) {
 
 void run_garage_posefuse(benchmark::State& state, bool chordal) {
   if (skip_without_garage(state)) return;
+  PoseGraphSE3Workspace& workspace = se3_workspace();
   PoseGraphSummary s;
   for (auto _ : state) {
     PoseGraphSE3 g = pose_graph_from_g2o(*garage());
-    if (chordal) g.initialize_chordal();
-    s = g.optimize();
+    if (chordal) g.initialize_chordal(workspace);
+    s = g.optimize({}, workspace);
     benchmark::DoNotOptimize(s);
   }
   state.counters["chi2"] = s.final_cost;

@@ -310,3 +310,35 @@ TEST_CASE("PoseGraphSE3: bad graphs are refused with a clear message", "[graph][
   CHECK_THROWS_WITH(g.initialize_chordal(), Catch::Contains("disconnected"));
   CHECK_THROWS_WITH(g.set_fixed(7), "pose graph: node 7 does not exist");
 }
+
+TEST_CASE("PoseGraphSE3: a workspace used by another graph gives the same result to the last bit",
+          "[graph][se3][workspace]") {
+  sim::PoseGraphProblemSE3Config c;
+  c.nodes = 150;
+  c.lap = 50;
+  const sim::PoseGraphProblemSE3 pr = sim::make_pose_graph_problem_se3(c);
+  c.nodes = 220;
+  c.seed = 9;
+  PoseGraphSE3Workspace used;
+  PoseGraphSE3 other = sim::to_pose_graph_se3(sim::make_pose_graph_problem_se3(c));
+  other.initialize_chordal(used);
+  (void)other.optimize({}, used);
+  CHECK(used.capacity_bytes() > 0);
+  PoseGraphSE3 a = sim::to_pose_graph_se3(pr);
+  PoseGraphSE3 b = a;
+  a.initialize_chordal();
+  b.initialize_chordal(used);
+  const PoseGraphSummary sa = a.optimize();
+  const PoseGraphSummary sb = b.optimize({}, used);
+  CHECK(sa.final_cost == sb.final_cost);
+  CHECK(sa.iterations == sb.iterations);
+  for (std::size_t k = 0; k < a.num_nodes(); ++k) {
+    CHECK(a.poses()[k].translation() == b.poses()[k].translation());
+    CHECK(a.poses()[k].so3().quaternion().coeffs() == b.poses()[k].so3().quaternion().coeffs());
+  }
+  CHECK(a.workspace_bytes() > 0);
+  a.release_workspace();
+  CHECK(a.workspace_bytes() == 0);
+  used.release();
+  CHECK(used.capacity_bytes() == 0);
+}

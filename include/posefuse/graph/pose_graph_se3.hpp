@@ -44,6 +44,32 @@ struct NormalEquationsSE3 {
   std::vector<std::int64_t> ids;  ///< node id of each 6-column block ([δt; δφ], see pose_graph_plus)
 };
 
+/// Buffers for PoseGraphSE3's solvers (as PoseGraphWorkspace for the 4-DoF
+/// graph): a program that builds and solves many graphs in turn may hold
+/// one and pass it to each solve, so that fresh memory is paged in once.
+/// Any workspace, empty or used before, gives the same answer to the last
+/// bit; copying one gives an empty one; one solve at a time.
+class PoseGraphSE3Workspace {
+ public:
+  PoseGraphSE3Workspace() = default;
+  /// An empty workspace (the buffers are not copied).
+  PoseGraphSE3Workspace(const PoseGraphSE3Workspace& /*other*/) noexcept {}
+  /// Keeps this workspace's own buffers.
+  PoseGraphSE3Workspace& operator=(const PoseGraphSE3Workspace& /*other*/) noexcept { return *this; }
+  PoseGraphSE3Workspace(PoseGraphSE3Workspace&&) noexcept = default;
+  PoseGraphSE3Workspace& operator=(PoseGraphSE3Workspace&&) noexcept = default;
+  ~PoseGraphSE3Workspace() = default;
+
+  /// Bytes of heap storage the buffers hold (capacity); 0 when empty.
+  [[nodiscard]] std::size_t capacity_bytes() const noexcept { return buffers_.capacity_bytes(); }
+  /// Frees every buffer.
+  void release() noexcept { buffers_ = {}; }
+
+ private:
+  friend class PoseGraphSE3;
+  detail::SolverBuffersSE3 buffers_;
+};
+
 /// An SE(3) pose graph: nodes with unique ids, relative edges, fixed nodes.
 ///
 /// Usage: add_node for every pose, add_edge for every measurement, optionally
@@ -53,16 +79,6 @@ struct NormalEquationsSE3 {
 class PoseGraphSE3 {
  public:
   PoseGraphSE3() = default;
-  PoseGraphSE3(const PoseGraphSE3& o)
-      : ids_(o.ids_), poses_(o.poses_), fixed_(o.fixed_), index_(o.index_), edges_(o.edges_), ends_(o.ends_),
-        layout_(o.layout_), layout_valid_(o.layout_valid_) {}
-  PoseGraphSE3& operator=(const PoseGraphSE3& o) {
-    if (this != &o) *this = PoseGraphSE3(o);
-    return *this;
-  }
-  PoseGraphSE3(PoseGraphSE3&&) noexcept = default;
-  PoseGraphSE3& operator=(PoseGraphSE3&&) noexcept = default;
-  ~PoseGraphSE3() = default;
 
   /// Reserves storage for `nodes` nodes and `edges` edges (optional).
   void reserve(std::size_t nodes, std::size_t edges) {
@@ -206,12 +222,15 @@ class PoseGraphSE3 {
   ///    translations; one exact Newton step minimises it.
   /// Robust losses are ignored here (weights 1).
   /// @throws posefuse::invalid_argument as validate(), or when a linear system is singular
-  void initialize_chordal() {
+  void initialize_chordal() { initialize_chordal(workspace_); }
+
+  /// initialize_chordal() with the caller's buffers (see PoseGraphSE3Workspace).
+  void initialize_chordal(PoseGraphSE3Workspace& workspace) {
     validate();
     const detail::PoseGraphLayout& L = layout();
     if (L.n == 0) return;
-    detail::chordal_rotations(edge_view(), L, poses_, workspace_.init);
-    detail::translations_for_rotations(edge_view(), L, poses_, workspace_.init);
+    detail::chordal_rotations(edge_view(), L, poses_, workspace.buffers_.init);
+    detail::translations_for_rotations(edge_view(), L, poses_, workspace.buffers_.init);
   }
 
   /// Minimises the cost over the free nodes' poses.
@@ -225,10 +244,14 @@ class PoseGraphSE3 {
   /// 4-DoF graph's (PoseGraphOptions). When no node is fixed, the first is
   /// held fixed.
   /// @throws posefuse::invalid_argument as validate()
-  PoseGraphSummary optimize(const PoseGraphOptions& options = {}) {
+  PoseGraphSummary optimize(const PoseGraphOptions& options = {}) { return optimize(options, workspace_); }
+
+  /// optimize() with the caller's buffers (see PoseGraphSE3Workspace): the
+  /// same result to the last bit, whatever the workspace held before.
+  PoseGraphSummary optimize(const PoseGraphOptions& options, PoseGraphSE3Workspace& workspace) {
     const auto t0 = std::chrono::steady_clock::now();
     validate();
-    detail::SolverBuffersSE3& w = workspace_;
+    detail::SolverBuffersSE3& w = workspace.buffers_;
     detail::PoseGraphAssemblySE3 assembly(edge_view(), w);
     detail::load_state_se3(poses_, w.x);
     PoseGraphSummary s = detail::levenberg_marquardt<6>(assembly, w, layout(), options);
@@ -260,7 +283,7 @@ class PoseGraphSE3 {
   }
 
   /// Frees the graph's solver buffers.
-  void release_workspace() noexcept { workspace_ = {}; }
+  void release_workspace() noexcept { workspace_.release(); }
   /// Bytes the graph's solver buffers hold (capacity; 0 before the first solve).
   [[nodiscard]] std::size_t workspace_bytes() const noexcept { return workspace_.capacity_bytes(); }
 
@@ -299,7 +322,7 @@ class PoseGraphSE3 {
   std::vector<std::pair<int, int>> ends_;  ///< node indices of each edge
   detail::PoseGraphLayout layout_;
   bool layout_valid_ = false;
-  detail::SolverBuffersSE3 workspace_;     ///< the solver's buffers (scratch, not state)
+  PoseGraphSE3Workspace workspace_;        ///< the solver's buffers (scratch, not state; a copy starts empty)
 };
 
 }  // namespace posefuse
