@@ -11,8 +11,22 @@
 //                   --imu V1_01_easy/imu0.csv --groundtruth V1_01_easy/groundtruth_20hz.csv
 //                   --out traj.tum
 //
-// The estimator starts at rest (the first frame after at least 1 s of IMU
-// samples at rest; frames before are "initializing" and not written).
+// The estimator starts as --start says (auto: at rest when the sequence
+// begins at rest; frames before the start are "initializing" and not written).
+//
+// Loop closure (posefuse/vio/loop_closure.hpp): --loops FILE reads loop
+// candidates (t_ns_query,t_ns_match csv); --loops recurring-ids derives them
+// from feature ids that recur in the tracks, an oracle that only simulated
+// tracks (simulate_tracks --recurring-ids) can give. Each keyframe leaving
+// the estimator's window joins a 4-DoF pose graph; each candidate is
+// verified (PnP + RANSAC) and accepted or refused with a reason; an accepted
+// one re-optimises the graph, and the drift correction it gives moves every
+// later output pose. --out then holds the corrected trajectory,
+// --out-odometry the estimator's own; every change of the correction is
+// printed with its stamp and the jump it makes (m, deg), and with a ground
+// truth the APE of both. --save-map writes the keyframe graph as a map,
+// --load-map localises the sequence in a saved map (candidates against the
+// map's keyframes: by recurring ids, or from the --loops file).
 // With --groundtruth (EuRoC csv; 17 columns give velocity and biases) it
 // prints APE of the position after position + yaw alignment and after SE(3)
 // alignment, RPE over 10 m, the final yaw error, the bias errors, and the
@@ -28,6 +42,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <optional>
@@ -41,8 +56,11 @@
 #include <posefuse/io/association.hpp>
 #include <posefuse/io/euroc.hpp>
 #include <posefuse/io/imu_gaps.hpp>
+#include <posefuse/io/loop_candidates.hpp>
 #include <posefuse/io/tum.hpp>
 #include <posefuse/vio/estimator.hpp>
+#include <posefuse/vio/loop_closure.hpp>
+#include <posefuse/vio/vio_map.hpp>
 
 namespace apps = posefuse::apps;
 
@@ -50,7 +68,9 @@ namespace {
 
 struct Options {
   std::filesystem::path tracks, camera, imu;
-  std::optional<std::filesystem::path> groundtruth, out;
+  std::optional<std::filesystem::path> groundtruth, out, out_odometry, save_map, load_map;
+  std::optional<std::string> loops;  // a file, or "recurring-ids"
+  std::string start = "auto";
   double max_imu_gap_ms = 50.0;
   double pixel_sigma_px = 1.0;
   int window = 10;
@@ -76,7 +96,27 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   cli.path({.name = "--imu", .value = "FILE", .help = "EuRoC imu0.csv (required)"}, imu);
   cli.path({.name = "--groundtruth", .value = "FILE", .help = "EuRoC ground truth csv: print the errors"},
            o.groundtruth);
-  cli.path({.name = "--out", .value = "FILE", .help = "write the trajectory (TUM)"}, o.out);
+  cli.path({.name = "--out", .value = "FILE", .help = "write the trajectory (TUM; loop-corrected with --loops)"},
+           o.out);
+  cli.path({.name = "--out-odometry", .value = "FILE", .help = "write the odometry without loop correction (TUM)"},
+           o.out_odometry);
+  cli.custom({.name = "--loops", .value = "FILE|recurring-ids",
+              .help = "loop candidates: a t_ns_query,t_ns_match csv, or from recurring feature ids\n"
+                      "(an oracle: simulated tracks with --recurring-ids only)"},
+             [&](std::string_view v) {
+               if (v.empty()) throw apps::usage_error("expected a file or recurring-ids, got ''");
+               o.loops = std::string(v);
+             });
+  cli.path({.name = "--save-map", .value = "FILE", .help = "write the keyframe graph as a map (needs --loops)"},
+           o.save_map);
+  cli.path({.name = "--load-map", .value = "FILE", .help = "localise in a saved map (needs --loops)"}, o.load_map);
+  cli.custom({.name = "--start", .value = "auto|static|dynamic", .help = "how the estimator starts",
+              .default_text = "auto"},
+             [&](std::string_view v) {
+               if (v != "auto" && v != "static" && v != "dynamic")
+                 throw apps::usage_error("expected auto, static or dynamic, got '" + std::string(v) + "'");
+               o.start = std::string(v);
+             });
   cli.real({.name = "--max-imu-gap-ms", .value = "MS", .help = "longest accepted IMU gap",
             .default_text = "50"},
            o.max_imu_gap_ms, apps::Domain::kPositive);
@@ -130,6 +170,7 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   cli.epilogue("Exit status: 0 ok, 1 bad data (file:line where a file is at fault), 2 bad usage.");
   if (!cli.parse(cmd)) return std::nullopt;
   if (!tracks || !camera || !imu) throw apps::usage_error("--tracks, --camera and --imu are required");
+  if ((o.save_map || o.load_map) && !o.loops) throw apps::usage_error("--save-map and --load-map need --loops");
   o.tracks = *tracks;
   o.camera = *camera;
   o.imu = *imu;
@@ -147,12 +188,117 @@ struct Summary {
   double final_yaw_error_deg = 0, max_yaw_error_deg = 0;
   bool have_bias = false;
   double gyro_bias_rms = 0, gyro_bias_final = 0, accel_bias_rms = 0, accel_bias_final = 0;
+  // Loop closure.
+  bool loops = false;
+  std::size_t candidates = 0, keyframes = 0, map_keyframes = 0;
+  std::map<std::string, int> loop_statuses;
+  std::map<std::string, std::string> loop_reason;  // one example per refusal status
+  struct Jump {
+    double t_s, m, deg;
+  };
+  std::vector<Jump> jumps;
+  posefuse::Statistics ape_odometry, ape_keyframes;
+  bool have_keyframe_ape = false;
 };
 
 double yaw_error_deg(const Eigen::Matrix3d& R_ref, const Eigen::Matrix3d& R_est) {
   const Eigen::Matrix3d E = R_ref * R_est.transpose();  // world-frame error
   return std::atan2(E(1, 0) - E(0, 1), E(0, 0) + E(1, 1)) * 180.0 / std::numbers::pi;
 }
+
+// APE position+yaw of `traj` against the ground truth (associated within 10 ms).
+posefuse::Statistics ape_posyaw(const posefuse::EurocGroundTruth& gt, const posefuse::Trajectory& traj) {
+  const posefuse::Association a = posefuse::associate(gt.trajectory.t_s, traj.t_s, 0.01, 0.0);
+  return posefuse::ape(posefuse::select(gt.trajectory, a.ref_ids), posefuse::select(traj, a.est_ids),
+                       posefuse::PoseRelation::kTranslation, posefuse::Alignment::kPosYaw)
+      .stats;
+}
+
+// The loop-closure side of a run: the database, the candidates still to
+// try, the oracle against a loaded map.
+class Loops {
+ public:
+  Loops(const Options& o, const posefuse::FeatureTracks& tracks, Summary& s) : s_(s) {
+    oracle_ = *o.loops == "recurring-ids";
+    if (oracle_) {
+      candidates_ = posefuse::loop_candidates_from_recurring_ids(tracks);
+    } else {
+      candidates_ = posefuse::read_loop_candidates(*o.loops);
+    }
+    if (o.load_map) {
+      const posefuse::VioMap m = posefuse::load_vio_map(*o.load_map);
+      s_.map_keyframes = m.keyframes.size();
+      (void)lc_.add_map(m, /*fixed=*/true);
+      have_map_ = true;
+    }
+  }
+
+  // A keyframe left the window: add it, then try the candidates it settles.
+  void add_keyframe(const posefuse::KeyframeRecord& r) {
+    const std::int64_t id = lc_.add_keyframe(r);
+    ++s_.keyframes;
+    const auto tol = std::int64_t(lc_options_.stamp_tolerance_s * 1e9);
+    while (next_ < candidates_.size() && candidates_[next_].t_query_ns + tol <= r.t_ns) {
+      ++s_.candidates;
+      record(lc_.add_loop(candidates_[next_++]));
+    }
+    // Against a loaded map, the oracle looks for the map keyframe sharing
+    // the most ids, once a second until the sequence is localised, then
+    // every 5 s.
+    if (have_map_ && oracle_ && r.t_ns - last_map_try_ >= (localised_ ? 5'000'000'000 : 1'000'000'000)) {
+      last_map_try_ = r.t_ns;
+      if (const auto m = lc_.shared_id_match(id, 30)) {
+        ++s_.candidates;
+        const posefuse::LoopResult x = lc_.add_loop_between(id, m->match_id);
+        localised_ = localised_ || x.status == posefuse::LoopStatus::kAccepted;
+        record(x);
+      }
+    }
+  }
+
+  // The candidates left whose query is not after the last frame processed
+  // (no output pose follows them; they still shape the saved map).
+  void finish(std::int64_t last_frame_ns) {
+    for (; next_ < candidates_.size() && candidates_[next_].t_query_ns <= last_frame_ns; ++next_) {
+      ++s_.candidates;
+      record(lc_.add_loop(candidates_[next_]));
+    }
+  }
+
+  // The correction of the live sequence; a change since the last call is a jump of `T`.
+  posefuse::SE3d correct(const posefuse::SE3d& T, double t_s) {
+    const posefuse::DriftCorrection c = lc_.correction();
+    const posefuse::SE3d out = c.apply(T);
+    if (have_last_ && (c.yaw != last_.yaw || c.t != last_.t)) {
+      const posefuse::SE3d before = last_.apply(T);
+      const double m = (out.translation() - before.translation()).norm();
+      const double deg = posefuse::wrap_angle(c.yaw - last_.yaw) * 180.0 / std::numbers::pi;
+      s_.jumps.push_back(Summary::Jump{t_s, m, deg});
+    }
+    last_ = c;
+    have_last_ = true;
+    return out;
+  }
+
+  [[nodiscard]] const posefuse::LoopClosure& closure() const { return lc_; }
+
+ private:
+  void record(const posefuse::LoopResult& r) {
+    const std::string name = posefuse::to_string(r.status);
+    ++s_.loop_statuses[name];
+    if (r.status != posefuse::LoopStatus::kAccepted && !s_.loop_reason.count(name)) s_.loop_reason[name] = r.reason;
+  }
+
+  Summary& s_;
+  posefuse::LoopClosureOptions lc_options_;
+  posefuse::LoopClosure lc_{lc_options_};
+  std::vector<posefuse::LoopCandidate> candidates_;
+  std::size_t next_ = 0;
+  bool oracle_ = false, have_map_ = false, localised_ = false;
+  std::int64_t last_map_try_ = std::numeric_limits<std::int64_t>::min() / 2;
+  posefuse::DriftCorrection last_;
+  bool have_last_ = false;
+};
 
 int run(const Options& o) {
   const posefuse::PinholeRadtan cam = posefuse::read_euroc_camera(o.camera);
@@ -176,11 +322,19 @@ int run(const Options& o) {
   eo.window.min_parallax_px = o.min_parallax_px;
   eo.window.outlier_threshold_px = o.outlier_px;
   eo.preintegration.max_gap_ns = std::int64_t(std::llround(o.max_imu_gap_ms * 1e6));
+  eo.start = o.start == "static"    ? posefuse::VioStart::kStatic
+             : o.start == "dynamic" ? posefuse::VioStart::kDynamic
+                                    : posefuse::VioStart::kAuto;
   posefuse::VioEstimator est(cam, eo);
   if (o.estimate_extrinsic) est.set_estimate_extrinsic(true);
 
   Summary s;
-  posefuse::Trajectory traj;
+  std::optional<Loops> loops;
+  if (o.loops) {
+    loops.emplace(o, tracks, s);
+    s.loops = true;
+  }
+  posefuse::Trajectory traj, odometry;
   std::vector<posefuse::ImuState> states;
   const bool progress = !o.json && isatty(STDERR_FILENO);
   std::size_t k = 0;
@@ -193,22 +347,27 @@ int run(const Options& o) {
     if (imu.back().t_ns < frame.t_ns) break;  // no IMU after this frame
     const auto t0 = std::chrono::steady_clock::now();
     const posefuse::VioFrameResult r = est.add_frame(frame);
+    if (loops && r.keyframe) loops->add_keyframe(*r.keyframe);
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     ++s.frames;
     ++s.statuses[posefuse::to_string(r.status)];
     if (r.status == posefuse::VioStatus::kInitializing) continue;
     total_ms += ms;
     s.ms_max = std::max(s.ms_max, ms);
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.linear() = r.state.R.matrix();
-    T.translation() = r.state.p;
-    if (!T.matrix().allFinite()) throw apps::data_error("a non-finite state at t = " + std::to_string(frame.t_ns) + " ns");
-    traj.push_back(posefuse::seconds_from_ns(frame.t_ns), T);
+    const posefuse::SE3d T(r.state.p, r.state.R);
+    if (!T.translation().allFinite() || !T.so3().quaternion().coeffs().allFinite())
+      throw apps::data_error("a non-finite state at t = " + std::to_string(frame.t_ns) + " ns");
+    const double t_s = posefuse::seconds_from_ns(frame.t_ns);
+    odometry.push_back(t_s, T.isometry());
+    traj.push_back(t_s, (loops ? loops->correct(T, t_s) : T).isometry());
     states.push_back(r.state);
     if (progress && f % 20 == 0)
       std::fprintf(stderr, "\rframe %zu / %zu  (%s)   ", f + 1, tracks.size(), posefuse::to_string(r.status));
   }
   if (progress) std::fprintf(stderr, "\r%60s\r", "");
+  std::int64_t last_frame_ns = 0;
+  if (s.frames > 0) last_frame_ns = tracks[s.frames - 1].t_ns;
+  if (loops) loops->finish(last_frame_ns);
   s.written = traj.size();
   if (traj.empty()) throw apps::data_error("no frame was estimated (the IMU is not at rest over the first second?)");
   s.ms_mean = total_ms / double(s.written);
@@ -217,6 +376,11 @@ int run(const Options& o) {
 
   apps::OutputFiles files;
   if (o.out) files.add_with(*o.out, [&](const std::filesystem::path& p) { posefuse::write_tum(p, traj); });
+  if (o.out_odometry)
+    files.add_with(*o.out_odometry, [&](const std::filesystem::path& p) { posefuse::write_tum(p, odometry); });
+  if (o.save_map)
+    files.add_with(*o.save_map,
+                   [&](const std::filesystem::path& p) { posefuse::save_vio_map(p, loops->closure().to_map()); });
   files.commit();
 
   if (gt) {
@@ -259,6 +423,19 @@ int run(const Options& o) {
       s.gyro_bias_rms = std::sqrt(sg / double(a.size()));
       s.accel_bias_rms = std::sqrt(sa / double(a.size()));
     }
+    if (loops) {
+      s.ape_odometry = ape_posyaw(*gt, odometry);
+      // The live sequence's keyframes at their final graph poses.
+      posefuse::Trajectory kf;
+      const posefuse::LoopClosure& lc = loops->closure();
+      for (const auto& x : lc.keyframes())
+        if (x.sequence == lc.live_sequence())
+          kf.push_back(posefuse::seconds_from_ns(x.record.t_ns), lc.corrected_pose(x.id).isometry());
+      if (kf.size() >= 3) {
+        s.ape_keyframes = ape_posyaw(*gt, kf);
+        s.have_keyframe_ape = true;
+      }
+    }
   }
 
   if (o.json) {
@@ -270,10 +447,28 @@ int run(const Options& o) {
     j.end_object();
     j.member("time_per_frame_ms", s.ms_mean).member("time_per_frame_max_ms", s.ms_max);
     j.member("duration_s", s.duration_s).member("processing_s", s.processing_s);
+    if (s.loops) {
+      j.member("keyframes", s.keyframes).member("map_keyframes", s.map_keyframes);
+      j.member("loop_candidates", s.candidates);
+      j.key("loop_statuses").begin_object(apps::JsonWriter::Layout::kInline);
+      for (const auto& [name, n] : s.loop_statuses) j.member(name, n);
+      j.end_object();
+      j.key("corrections").begin_array(apps::JsonWriter::Layout::kBlock);
+      for (const Summary::Jump& x : s.jumps) {
+        j.begin_object(apps::JsonWriter::Layout::kInline);
+        j.member("t_s", x.t_s).member("jump_m", x.m).member("jump_deg", x.deg);
+        j.end_object();
+      }
+      j.end_array();
+    }
     if (s.have_gt) {
       j.member("matched", s.matched);
       j.member("ape_posyaw_rmse_m", s.ape_posyaw.rmse).member("ape_posyaw_max_m", s.ape_posyaw.max);
       j.member("ape_se3_rmse_m", s.ape_se3.rmse).member("ape_se3_max_m", s.ape_se3.max);
+      if (s.loops) {
+        j.member("ape_posyaw_odometry_rmse_m", s.ape_odometry.rmse);
+        if (s.have_keyframe_ape) j.member("ape_posyaw_keyframes_graph_rmse_m", s.ape_keyframes.rmse);
+      }
       if (s.have_rpe) j.member("rpe_10m_rmse_m", s.rpe10.rmse);
       j.member("final_yaw_error_deg", s.final_yaw_error_deg).member("max_yaw_error_deg", s.max_yaw_error_deg);
       if (s.have_bias) {
@@ -290,9 +485,25 @@ int run(const Options& o) {
   std::printf("\n");
   std::printf("time per frame         %.2f ms mean, %.2f ms max (%.1f s for %.1f s of data)\n", s.ms_mean,
               s.ms_max, s.processing_s, s.duration_s);
+  if (s.loops) {
+    std::printf("keyframes              %zu", s.keyframes);
+    if (s.map_keyframes > 0) std::printf(" (and %zu in the loaded map)", s.map_keyframes);
+    std::printf("\nloop candidates        %zu:", s.candidates);
+    for (const auto& [name, n] : s.loop_statuses) std::printf("  %s %d", name.c_str(), n);
+    std::printf("\n");
+    for (const auto& [name, why] : s.loop_reason) std::printf("  refused, %s: e.g. %s\n", name.c_str(), why.c_str());
+    for (const Summary::Jump& x : s.jumps)
+      std::printf("correction at t = %.3f s: output jumps %.4f m, %.3f deg\n", x.t_s, x.m, x.deg);
+  }
   if (s.have_gt) {
-    std::printf("APE position+yaw       rmse %.4f m, max %.4f m (%zu poses)\n", s.ape_posyaw.rmse, s.ape_posyaw.max,
-                s.matched);
+    if (s.loops) {
+      std::printf("APE position+yaw       rmse %.4f m without loop closure (odometry)\n", s.ape_odometry.rmse);
+      if (s.have_keyframe_ape)
+        std::printf("APE position+yaw       rmse %.4f m, keyframes at their final graph poses\n",
+                    s.ape_keyframes.rmse);
+    }
+    std::printf("APE position+yaw       rmse %.4f m, max %.4f m (%zu poses%s)\n", s.ape_posyaw.rmse, s.ape_posyaw.max,
+                s.matched, s.loops ? ", written with loop correction" : "");
     std::printf("APE SE(3)              rmse %.4f m, max %.4f m\n", s.ape_se3.rmse, s.ape_se3.max);
     if (s.have_rpe) std::printf("RPE per 10 m           rmse %.4f m\n", s.rpe10.rmse);
     std::printf("yaw error              final %.3f deg, max %.3f deg (after position+yaw alignment)\n",

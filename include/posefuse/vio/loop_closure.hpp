@@ -27,7 +27,8 @@
 /// sequence (the match's own point first, then the nearest neighbour's);
 /// fewer than `min_inliers` → kTooFewCorrespondences. PnP + RANSAC
 /// (vio/pnp.hpp, solve_pnp_ransac) gives the query camera in the match's
-/// odometry frame, hence \f$ T_{match,query} \f$; fewer than `min_inliers`
+/// odometry frame, hence \f$ T_{match,query} \f$ (when both are in one
+/// group, the graph's relative pose is RANSAC's first hypothesis); fewer than `min_inliers`
 /// inliers or a PnP failure → kPnpFailed with PnP's reason. A relative pose
 /// farther than VINS-Mono's bounds (`max_relative_yaw_deg`,
 /// `max_relative_distance_m`) → kImplausible.
@@ -175,6 +176,12 @@ struct LoopResult {
   DriftCorrection before, after;         ///< the live sequence's correction around the update
 };
 
+/// LoopClosure::shared_id_match(): a keyframe and how many feature ids it shares.
+struct SharedIdMatch {
+  std::int64_t match_id = -1;  ///< node id
+  int shared_ids = 0;          ///< feature ids in common
+};
+
 /// The keyframe database, loop verification and 4-DoF pose graph (see the file comment).
 class LoopClosure {
  public:
@@ -304,7 +311,14 @@ class LoopClosure {
                    std::to_string(o_.min_inliers);
       return res;
     }
-    const PnpResult pnp = solve_pnp_ransac(P, M, o_.pnp);
+    // Within one group the graph already relates query and match: their
+    // relative pose, put in the match's odometry frame, is RANSAC's first
+    // hypothesis (as VINS-Mono starts its PnP from the odometry); it is
+    // scored like any other and wins only on its inliers.
+    std::optional<SE3d> guess;
+    if (seq_[std::size_t(q.sequence)].group == seq_[std::size_t(m.sequence)].group)
+      guess = m.record.T_w_b * (corrected_pose(m.id).inverse() * corrected_pose(q.id)) * q.record.T_b_c;
+    const PnpResult pnp = solve_pnp_ransac(P, M, o_.pnp, guess);
     res.inliers = pnp.inliers;
     res.rms_residual = pnp.rms_residual;
     if (pnp.status != PnpStatus::kOk) {
@@ -332,6 +346,34 @@ class LoopClosure {
     }
     res.status = LoopStatus::kAccepted;
     return res;
+  }
+
+  /// **Oracle** candidate from recurring feature ids: the keyframe of
+  /// another sequence sharing the most feature ids with keyframe
+  /// `query_id` (the earliest on a tie), when they share at least
+  /// `min_shared` (then verify with add_loop_between(query_id, match_id)).
+  /// Meaningful only when an id names one landmark for ever
+  /// (simulated tracks with recurring ids, io/loop_candidates.hpp); used to
+  /// find where a new session is in a loaded map. The candidate still goes
+  /// through verification.
+  /// @throws posefuse::invalid_argument for an unknown id
+  [[nodiscard]] std::optional<SharedIdMatch> shared_id_match(std::int64_t query_id, int min_shared) const {
+    const Keyframe& q = keyframe(query_id);
+    std::unordered_map<std::size_t, int> count;
+    for (const KeyframeFeature& f : q.record.features) {
+      const auto it = keyframes_of_id_.find(f.id);
+      if (it == keyframes_of_id_.end()) continue;
+      for (const std::size_t k : it->second)
+        if (kf_[k].sequence != q.sequence) ++count[k];
+    }
+    std::optional<SharedIdMatch> best;
+    std::size_t best_k = 0;
+    for (const auto& [k, n] : count)
+      if (n >= min_shared && (!best || n > best->shared_ids || (n == best->shared_ids && k < best_k))) {
+        best = SharedIdMatch{kf_[k].id, n};
+        best_k = k;
+      }
+    return best;
   }
 
   /// The keyframe nearest to `t_ns` within the tolerance (any sequence; the
@@ -495,6 +537,7 @@ class LoopClosure {
   void add_node(Keyframe k, const Pose4Dof& pose, bool fixed) {
     graph_.add_node(k.id, pose, fixed);
     index_.emplace(k.id, kf_.size());
+    for (const KeyframeFeature& f : k.record.features) keyframes_of_id_[f.id].push_back(kf_.size());
     seq_[std::size_t(k.sequence)].nodes.push_back(kf_.size());
     kf_.push_back(std::move(k));
   }
@@ -577,6 +620,7 @@ class LoopClosure {
   std::vector<Keyframe> kf_;
   std::unordered_map<std::int64_t, std::size_t> index_;  // node id -> kf_ index
   std::vector<Sequence> seq_;
+  std::unordered_map<std::uint64_t, std::vector<std::size_t>> keyframes_of_id_;  // feature id -> kf_ indices
   std::unordered_set<std::int64_t> anchors_;  // fixed nodes that only fix their group's gauge
   int live_ = -1;
   std::int64_t next_id_ = 0;
