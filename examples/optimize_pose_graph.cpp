@@ -51,6 +51,7 @@
 #include <apps/json.hpp>
 #include <apps/output_file.hpp>
 #include <apps/progress.hpp>
+#include <apps/spooled_input.hpp>
 #include <posefuse/sim/pose_graph_4dof.hpp>
 #include <posefuse/core/error.hpp>
 #include <posefuse/eval/alignment.hpp>
@@ -70,6 +71,7 @@ struct Options {
   bool json = false;
   PoseGraphOptions solver;
   RobustKernel loss;
+  std::string input_name;  ///< --input's file name as given (the reader may read a copy of a pipe)
 };
 
 std::optional<Options> parse_options(const apps::CommandLine& cmd) {
@@ -290,7 +292,7 @@ int run_3d(const Options& o) {
     if (e.t.cwiseAbs().maxCoeff() > kMaxCoordinate || e.information.cwiseAbs().maxCoeff() > kMaxInformation)
       throw io_error(*o.input, e.line,
                      "a translation beyond 1e+50 or an information entry beyond 1e+100, which the solver cannot hold");
-  const std::string name = o.input->filename().string();
+  const std::string name = o.input_name;
   PoseGraphSE3 graph;
   try {
     graph = pose_graph_from_g2o(file_graph, o.loss);
@@ -355,8 +357,7 @@ int run_3d(const Options& o) {
   return 0;
 }
 
-int run(const Options& o) {
-  if (o.input && g2o_dimension(*o.input) == 3) return run_3d(o);
+int run_2d(const Options& o) {
   // On a terminal, standard error shows the stage and the solver's iterations.
   apps::TerminalProgress progress("optimize_pose_graph");
   G2oGraph2d file_graph;
@@ -369,7 +370,7 @@ int run(const Options& o) {
                    std::to_string(file_graph.edges.size()) + " edges");
     check_magnitudes(file_graph, *o.input);
     check_nodes_are_fixed(file_graph, *o.input);
-    name = o.input->filename().string();
+    name = o.input_name;
     try {
       graph = pose_graph_from_g2o(file_graph, o.loss);
     } catch (const posefuse::invalid_argument& e) {
@@ -461,6 +462,26 @@ int run(const Options& o) {
     std::printf("\n");
   }
   return 0;
+}
+
+/// Detects the file's format (2-D or 3-D) and runs. Detection reads the
+/// file before its reader does: a pipe or <(command) is copied once
+/// (apps/spooled_input.hpp), and messages name the path as given.
+int run(const Options& given) {
+  apps::SpooledInputs spool;
+  Options o = given;
+  if (o.input) {
+    o.input_name = o.input->filename().string();
+    o.input = spool.readable(*given.input);
+  }
+  try {
+    return o.input && g2o_dimension(*o.input) == 3 ? run_3d(o) : run_2d(o);
+  } catch (const apps::usage_error&) {
+    throw;
+  } catch (const std::exception& e) {
+    if (!o.input || *o.input == *given.input) throw;
+    throw apps::data_error(spool.shown(std::string(e.what())));
+  }
 }
 
 }  // namespace

@@ -299,6 +299,41 @@ std::string plot(const Trajectory& truth, const Trajectory& before, const Trajec
   return doc.str();
 }
 
+/// --dof 4: the 4-DoF graph of the odometry and the loop edges (outliers
+/// included); the corrected poses go to after_up.
+PoseGraphSummary correct_4dof(const Options& o, const Trajectory& odo_up, const std::vector<Edge4Dof>& loops,
+                              const std::string& name, apps::TerminalProgress& progress, Trajectory& after_up) {
+  PoseGraph4Dof graph;
+  try {
+    for (std::size_t k = 0; k < odo_up.size(); ++k)
+      graph.add_node(static_cast<std::int64_t>(k), to_pose(odo_up.poses[k]), k == 0);
+    const Eigen::Matrix4d odo_info = information(o.sigma_odo_p, o.sigma_odo_yaw_deg * std::numbers::pi / 180);
+    for (std::size_t k = 0; k + 1 < odo_up.size(); ++k) {
+      Edge4Dof e = sim::relative_edge(to_pose(odo_up.poses[k]), to_pose(odo_up.poses[k + 1]),
+                                      static_cast<std::int64_t>(k), static_cast<std::int64_t>(k + 1));
+      e.information = odo_info;
+      graph.add_edge(e);
+    }
+    for (Edge4Dof e : loops) {
+      e.loss = o.loss;
+      graph.add_edge(e);
+    }
+  } catch (const posefuse::invalid_argument& e) {
+    throw apps::data_error(name + ": " + e.what());
+  }
+  PoseGraphOptions solver;
+  if (progress.enabled()) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "solving: %zu nodes, %zu edges", graph.num_nodes(), graph.num_edges());
+    progress.stage(buf);
+    solver.progress = apps::solver_progress<PoseGraphIteration>(progress, solver.max_iterations);
+  }
+  const PoseGraphSummary s = graph.optimize(solver);
+  after_up = odo_up;
+  for (std::size_t k = 0; k < after_up.size(); ++k) after_up.poses[k] = to_isometry(graph.poses()[k]);
+  return s;
+}
+
 SE3d to_se3(const Eigen::Isometry3d& T) {
   return SE3d(T.translation(), SO3d(Eigen::Quaterniond(T.linear())));
 }
@@ -315,7 +350,7 @@ Matrix6d information_se3(double sp, double sr) {
 /// --dof 6: the SE(3) graph of the odometry (relative motions), the loop
 /// edges' node pairs measured from the truth (the oracle's, or the
 /// simulator's) and the outliers (identity measurements); returns the
-/// corrected poses.
+/// corrected poses (in after_up).
 PoseGraphSummary correct_se3(const Options& o, const Trajectory& odo_up, const Trajectory& truth_up,
                              const std::vector<Edge4Dof>& loops, std::size_t first_outlier, const std::string& name,
                              apps::TerminalProgress& progress, Trajectory& after_up) {
@@ -416,39 +451,9 @@ int run(const Options& o) {
   for (const Edge4Dof& e : outlier_loops(truth_up, outliers, o.seed, loop_info)) loops.push_back(e);
 
   Trajectory after_up;
-  PoseGraphSummary s;
-  if (o.dof == 6) {
-    s = correct_se3(o, odo_up, truth_up, loops, first_outlier, name, progress, after_up);
-  } else {
-  PoseGraph4Dof graph;
-  try {
-    for (std::size_t k = 0; k < odo_up.size(); ++k)
-      graph.add_node(static_cast<std::int64_t>(k), to_pose(odo_up.poses[k]), k == 0);
-    const Eigen::Matrix4d odo_info = information(o.sigma_odo_p, o.sigma_odo_yaw_deg * std::numbers::pi / 180);
-    for (std::size_t k = 0; k + 1 < odo_up.size(); ++k) {
-      Edge4Dof e = sim::relative_edge(to_pose(odo_up.poses[k]), to_pose(odo_up.poses[k + 1]),
-                                      static_cast<std::int64_t>(k), static_cast<std::int64_t>(k + 1));
-      e.information = odo_info;
-      graph.add_edge(e);
-    }
-    for (Edge4Dof e : loops) {
-      e.loss = o.loss;
-      graph.add_edge(e);
-    }
-  } catch (const posefuse::invalid_argument& e) {
-    throw apps::data_error(name + ": " + e.what());
-  }
-  PoseGraphOptions solver;
-  if (progress.enabled()) {
-    char buf[160];
-    std::snprintf(buf, sizeof buf, "solving: %zu nodes, %zu edges", graph.num_nodes(), graph.num_edges());
-    progress.stage(buf);
-    solver.progress = apps::solver_progress<PoseGraphIteration>(progress, solver.max_iterations);
-  }
-  s = graph.optimize(solver);
-  after_up = odo_up;
-  for (std::size_t k = 0; k < after_up.size(); ++k) after_up.poses[k] = to_isometry(graph.poses()[k]);
-  }
+  const PoseGraphSummary s = o.dof == 6
+                                 ? correct_se3(o, odo_up, truth_up, loops, first_outlier, name, progress, after_up)
+                                 : correct_4dof(o, odo_up, loops, name, progress, after_up);
   progress.clear();
   const Ape before = ape_of(truth_up, odo_up);
   const Ape after = ape_of(truth_up, after_up);

@@ -3,7 +3,12 @@
 
 #include <catch2/catch.hpp>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -120,4 +125,34 @@ TEST_CASE("pose_graph_correction: --dof 6 corrects in SE(3) and says so", "[grap
       dir);
   CHECK(refused.status == 2);
   CHECK_THAT(refused.err, Catch::Contains("--dof 6 use --oracle-loops"));
+}
+
+TEST_CASE("optimize_pose_graph reads a named pipe once when it detects the format", "[graph][se3][examples]") {
+  POSEFUSE_REQUIRE_EXAMPLE(exe, "optimize_pose_graph");
+  TempDir dir("optimize_fifo");
+  const auto in = write_sim_graph(dir, "sim.g2o");
+  const auto bad = write_text(dir, "bad.g2o", "VERTEX_SE3:QUAT 0 0 0 0 0 0 0 1\nEDGE_SE3:QUAT 0 0\n");
+  for (const auto& file : {in, bad}) {
+    const std::filesystem::path fifo = dir.path() / "graph.fifo";
+    std::filesystem::remove(fifo);
+    REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+    // The writer blocks until the program opens the pipe; `timeout` ends a
+    // program that would open it a second time and wait forever.
+    const std::string writer = "cat '" + file.string() + "' > '" + fifo.string() + "' &";
+    REQUIRE(std::system(writer.c_str()) == 0);
+    const auto r = posefuse::test::run("/usr/bin/timeout", "20 '" + exe.string() + "' --input '" + fifo.string() + "' --json", dir);
+    const int fd = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK);  // unblocks a writer never read
+    if (fd >= 0) ::close(fd);
+    INFO(r.err);
+    if (file == in) {
+      REQUIRE(r.status == 0);
+      const posefuse::test::Json j = posefuse::test::Json::parse(r.out);
+      CHECK(j["dof"].number() == 6);
+      CHECK(j["input"].string() == "graph.fifo");
+    } else {
+      CHECK(r.status == 1);
+      // The message names the pipe as given, not the program's copy of it.
+      CHECK_THAT(r.err, Catch::Contains(fifo.string() + ":2: EDGE_SE3:QUAT expects 30 fields"));
+    }
+  }
 }
