@@ -300,7 +300,7 @@ class LoopClosure {
     std::vector<Eigen::Vector2d> M;
     for (const KeyframeFeature& f : q.record.features) {
       const auto it = points.find(f.id);
-      if (it == points.end() || !f.m.allFinite()) continue;
+      if (it == points.end() || !f.m.allFinite() || !it->second.allFinite()) continue;
       P.push_back(it->second);
       M.push_back(f.m);
     }
@@ -386,8 +386,8 @@ class LoopClosure {
       const std::vector<std::size_t>& nodes = seq_[std::size_t(s)].nodes;
       const auto it = std::lower_bound(nodes.begin(), nodes.end(), t_ns,
                                        [&](std::size_t k, std::int64_t t) { return kf_[k].record.t_ns < t; });
-      for (auto j = it; j != nodes.end() && j <= it + 1; ++j) consider(*j, t_ns, best, best_dt);
-      if (it != nodes.begin()) consider(*(it - 1), t_ns, best, best_dt);
+      if (it != nodes.end()) consider(*it, t_ns, best, best_dt);  // the first at or after t_ns
+      if (it != nodes.begin()) consider(*(it - 1), t_ns, best, best_dt);  // the last before
     }
     return best;
   }
