@@ -131,6 +131,32 @@ TEST_CASE("SfM: 1 px noise gives poses within 2.5 cm and 0.4 deg after a similar
   }
 }
 
+TEST_CASE("SfM: 3 % wrong associations are left out and the poses stay close", "[vio][sfm]") {
+  // 1 px noise and, in every frame, 3 % of the observations replaced by a
+  // random point of the image; same bounds as without them
+  Window w = make_window(Motion::kSideways, 41, 1.0);
+  std::mt19937_64 rng(42);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int wrong = 0;
+  for (auto& frame : w.frames) {
+    for (std::size_t i = 0; i < frame.size(); i += 33) {
+      frame[i].m = Eigen::Vector2d(u(rng), u(rng));
+      ++wrong;
+    }
+  }
+  const auto r = posefuse::structure_from_motion(w.frames);
+  INFO(r.reason);
+  REQUIRE(r.status == SfmStatus::kOk);
+  const Errors e = errors_after_alignment(r, w);
+  INFO("position error " << e.position << " m, rotation error " << e.rotation / kDeg << " deg, " << wrong
+                         << " wrong, " << r.outlier_observations << " left out");
+  CHECK(e.position <= 0.025);
+  CHECK(e.rotation <= 0.4 * kDeg);
+  CHECK(r.rms_reprojection_px <= 1.5);
+  CHECK(r.outlier_observations >= wrong / 2);    // the rest never got a point or fell near the truth
+  CHECK(r.outlier_observations <= wrong + 10);  // 1 px noise exceeds 5 px about once in 270000
+}
+
 TEST_CASE("SfM: hovering and rotating in place are failures with reasons", "[vio][sfm]") {
   for (double sigma : {0.0, 1.0}) {
     const Window hover = make_window(Motion::kHover, 21, sigma);

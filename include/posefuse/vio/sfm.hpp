@@ -31,6 +31,9 @@
 ///     held fixed, and of the newest frame's translation step (in its own
 ///     frame) the coordinate along which the l–newest baseline is largest,
 ///     which holds the scale; the l–newest distance stays close to 1.
+///     Observations then off by more than `outlier_px` (wrong associations)
+///     are left out, points left with fewer than two views dropped, and the
+///     adjustment run again.
 ///  5. Everything is re-expressed in frame 0's camera: `T_c0_c[0]` is the
 ///     identity, `points_c0` are in frame 0.
 ///
@@ -50,6 +53,8 @@
 #include <cmath>
 #include <cstdint>
 #include <map>
+#include <set>
+#include <utility>
 #include <span>
 #include <string>
 #include <vector>
@@ -110,6 +115,7 @@ struct SfmOptions {
   double loss_scale_px = 1.5;           ///< Cauchy scale of the bundle adjustment (px), > 0
   double max_rms_reprojection_px = 3.0;  ///< RMS reprojection error above this fails, > 0
   int min_points = 20;                  ///< fewer triangulated points is kDegenerate, ≥ 1
+  double outlier_px = 5.0;              ///< after the adjustment, observations off by more are left out, > 0
 };
 
 /// Result of structure_from_motion.
@@ -119,7 +125,8 @@ struct SfmResult {
   std::vector<SE3d> T_c0_c;                     ///< one per frame, T_c0_c[0] = identity, up to scale
   std::map<std::uint64_t, Eigen::Vector3d> points_c0;  ///< triangulated features in frame 0's camera
   int reference_frame = -1;                     ///< l (-1 when none was found)
-  double rms_reprojection_px = 0;               ///< over every observation of a point, after the adjustment
+  double rms_reprojection_px = 0;               ///< over the kept observations of the points, after the adjustment
+  int outlier_observations = 0;                 ///< observations left out (off by more than outlier_px)
 };
 
 /// Structure from motion on a window (see the file comment).
@@ -131,7 +138,7 @@ struct SfmResult {
                                                      const SfmOptions& o = {}) {
   if (!(o.focal_px > 0) || !(o.min_parallax_px >= 0) || o.min_correspondences < 8 || o.ba_iterations < 0 ||
       !(o.min_triangulation_parallax_rad >= 0) || !(o.loss_scale_px > 0) || !(o.max_rms_reprojection_px > 0) ||
-      o.min_points < 1)
+      o.min_points < 1 || !(o.outlier_px > 0))
     throw invalid_argument("structure_from_motion: options out of range");
   const int N = int(frames.size());
   std::vector<std::map<std::uint64_t, Eigen::Vector2d>> obs(frames.size());
@@ -241,6 +248,7 @@ struct SfmResult {
   // by two of them; the other frames are held. Gauge: frame l, and the
   // newest frame's translation step along its largest baseline coordinate.
   const ReprojectionLoss loss{ReprojectionLoss::Kind::kCauchy, o.loss_scale_px};
+  std::set<std::pair<int, std::uint64_t>> rejected;  // (frame, id) left out as outliers
   struct AdjustedPoints {
     std::vector<std::uint64_t> ids;
     std::vector<std::vector<detail::BaObservation>> obs;
@@ -251,7 +259,7 @@ struct SfmResult {
     for (const auto& [id, p] : pts) {
       std::vector<detail::BaObservation> ob;
       for (int f : views.at(id))
-        if (active[std::size_t(f)]) ob.push_back({f, obs[std::size_t(f)].at(id)});
+        if (active[std::size_t(f)] && !rejected.count({f, id})) ob.push_back({f, obs[std::size_t(f)].at(id)});
       if (ob.size() < 2) continue;
       a.ids.push_back(id);
       a.obs.push_back(std::move(ob));
@@ -310,8 +318,15 @@ struct SfmResult {
     return res;
   }
 
-  // 4. Bundle adjustment over every frame.
-  const AdjustedPoints all = adjust(std::vector<char>(frames.size(), 1), o.ba_iterations);
+  // 4. Bundle adjustment over every frame; observations then off by more
+  // than outlier_px are left out and the adjustment repeated.
+  AdjustedPoints all = adjust(std::vector<char>(frames.size(), 1), o.ba_iterations);
+  for (std::size_t j = 0; j < all.ids.size(); ++j)
+    for (const detail::BaObservation& x : all.obs[j])
+      if (o.focal_px * reprojection_residual(T[std::size_t(x.frame)], pts.at(all.ids[j]), x.m).norm() > o.outlier_px)
+        rejected.insert({x.frame, all.ids[j]});
+  if (!rejected.empty()) all = adjust(std::vector<char>(frames.size(), 1), o.ba_iterations);
+  res.outlier_observations = int(rejected.size());
   const std::vector<std::uint64_t>& ids = all.ids;
   std::vector<Eigen::Vector3d> P;
   for (std::uint64_t id : ids) P.push_back(pts.at(id));
