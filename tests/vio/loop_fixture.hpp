@@ -58,10 +58,17 @@ struct LoopScene {
 
   // The keyframe record the odometry would give at time t with drift d.
   [[nodiscard]] KeyframeRecord record(double t, const Drift& d, std::uint64_t seed) const {
+    return record_seen_from(t, d, seed, truth(t));
+  }
+
+  // As record(), but the features are what a camera at body pose `view`
+  // (true frame) would see: with view != truth(t), a consistent but false
+  // view of another place (perceptual aliasing).
+  [[nodiscard]] KeyframeRecord record_seen_from(double t, const Drift& d, std::uint64_t seed, const SE3d& view) const {
     std::mt19937_64 g(seed);
     std::normal_distribution<double> px(0.0, 0.5 / 460.0), pt(0.0, 0.01);
     const SE3d T_w_b = truth(t);
-    const SE3d T_w_c = T_w_b * T_b_c;
+    const SE3d T_w_c = view * T_b_c;
     const SE3d T_c_w = T_w_c.inverse();
     const DriftCorrection D = d.at(t);
     KeyframeRecord r;
