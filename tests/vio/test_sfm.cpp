@@ -116,18 +116,17 @@ TEST_CASE("SfM: 1 px noise gives poses within 2.5 cm and 0.4 deg after a similar
   // errors seen over seeds 11-20 and both motions (1.2 cm, 0.20 deg; RMS
   // reprojection error 1.29-1.34 px, the sqrt(2) px of 1 px noise per axis
   // less the fitted degrees of freedom)
-  for (std::uint64_t seed = 11; seed <= 12; ++seed) {
-    for (Motion motion : {Motion::kSideways, Motion::kOutAndBack}) {
-      const Window w = make_window(motion, seed, 1.0);
-      const auto r = posefuse::structure_from_motion(w.frames);
-      INFO("seed " << seed << " motion " << int(motion) << ": " << r.reason);
-      REQUIRE(r.status == SfmStatus::kOk);
-      const Errors e = errors_after_alignment(r, w);
-      INFO("position error " << e.position << " m, rotation error " << e.rotation / kDeg << " deg");
-      CHECK(e.position <= 0.025);
-      CHECK(e.rotation <= 0.4 * kDeg);
-      CHECK(r.rms_reprojection_px <= 1.5);
-    }
+  // (one seed per motion: the case runs under the sanitizers too)
+  for (Motion motion : {Motion::kSideways, Motion::kOutAndBack}) {
+    const Window w = make_window(motion, 11, 1.0);
+    const auto r = posefuse::structure_from_motion(w.frames);
+    INFO("motion " << int(motion) << ": " << r.reason);
+    REQUIRE(r.status == SfmStatus::kOk);
+    const Errors e = errors_after_alignment(r, w);
+    INFO("position error " << e.position << " m, rotation error " << e.rotation / kDeg << " deg");
+    CHECK(e.position <= 0.025);
+    CHECK(e.rotation <= 0.4 * kDeg);
+    CHECK(r.rms_reprojection_px <= 1.5);
   }
 }
 
