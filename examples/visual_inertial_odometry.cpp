@@ -11,8 +11,8 @@
 //                   --imu V1_01_easy/imu0.csv --groundtruth V1_01_easy/groundtruth_20hz.csv
 //                   --out traj.tum
 //
-// The estimator starts as --start says (auto: at rest when the sequence
-// begins at rest; frames before the start are "initializing" and not written).
+// The estimator starts at rest (the first frame after at least 1 s of IMU
+// samples at rest; frames before are "initializing" and not written).
 //
 // Loop closure (posefuse/vio/loop_closure.hpp): --loops FILE reads loop
 // candidates (t_ns_query,t_ns_match csv); --loops recurring-ids derives them
@@ -70,7 +70,6 @@ struct Options {
   std::filesystem::path tracks, camera, imu;
   std::optional<std::filesystem::path> groundtruth, out, out_odometry, save_map, load_map;
   std::optional<std::string> loops;  // a file, or "recurring-ids"
-  std::string start = "auto";
   double max_imu_gap_ms = 50.0;
   double pixel_sigma_px = 1.0;
   int window = 10;
@@ -110,13 +109,6 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   cli.path({.name = "--save-map", .value = "FILE", .help = "write the keyframe graph as a map (needs --loops)"},
            o.save_map);
   cli.path({.name = "--load-map", .value = "FILE", .help = "localise in a saved map (needs --loops)"}, o.load_map);
-  cli.custom({.name = "--start", .value = "auto|static|dynamic", .help = "how the estimator starts",
-              .default_text = "auto"},
-             [&](std::string_view v) {
-               if (v != "auto" && v != "static" && v != "dynamic")
-                 throw apps::usage_error("expected auto, static or dynamic, got '" + std::string(v) + "'");
-               o.start = std::string(v);
-             });
   cli.real({.name = "--max-imu-gap-ms", .value = "MS", .help = "longest accepted IMU gap",
             .default_text = "50"},
            o.max_imu_gap_ms, apps::Domain::kPositive);
@@ -322,9 +314,6 @@ int run(const Options& o) {
   eo.window.min_parallax_px = o.min_parallax_px;
   eo.window.outlier_threshold_px = o.outlier_px;
   eo.preintegration.max_gap_ns = std::int64_t(std::llround(o.max_imu_gap_ms * 1e6));
-  eo.start = o.start == "static"    ? posefuse::VioStart::kStatic
-             : o.start == "dynamic" ? posefuse::VioStart::kDynamic
-                                    : posefuse::VioStart::kAuto;
   posefuse::VioEstimator est(cam, eo);
   if (o.estimate_extrinsic) est.set_estimate_extrinsic(true);
 

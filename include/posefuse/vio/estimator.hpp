@@ -60,23 +60,6 @@ enum class VioStatus { kInitializing, kTracking, kNotEnoughFeatures, kDegenerate
   return "unknown";
 }
 
-/// How the estimator starts (see the file comment).
-enum class VioStart {
-  kAuto,     ///< static when the sequence begins at rest, dynamic otherwise
-  kStatic,   ///< only at rest
-  kDynamic,  ///< only from structure from motion + visual-inertial alignment
-};
-
-/// Name of a VioStart ("auto", "static", "dynamic").
-[[nodiscard]] constexpr const char* to_string(VioStart s) noexcept {
-  switch (s) {
-    case VioStart::kAuto: return "auto";
-    case VioStart::kStatic: return "static";
-    case VioStart::kDynamic: return "dynamic";
-  }
-  return "unknown";
-}
-
 /// Standard deviations of the first frame's prior.
 struct VioInitialSigma {
   double position_m = 1e-3;        ///< each axis
@@ -94,7 +77,6 @@ struct VioEstimatorOptions {
   PreintegrationOptions preintegration; ///< gap limit, re-propagation thresholds
   StaticInitOptions static_init;        ///< static start
   VioInitialSigma initial_sigma;        ///< prior on the first frame
-  VioStart start = VioStart::kAuto;     ///< how to start without an explicit initial state
   int min_features = 10;                ///< below this a frame is kNotEnoughFeatures
   double max_speed_mps = 50.0;          ///< above this the window is reset
 };
