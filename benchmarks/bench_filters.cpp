@@ -40,6 +40,15 @@
 //   Pose15                15-state 3-D kinematics (position, roll-pitch-yaw,
 //                         their rates, linear acceleration; world frame, angles
 //                         unwrapped) with a 6-D pose measurement
+//   CtrvEkf               5-state constant turn rate and velocity (models/ctrv.hpp),
+//                         2-D position fix, dt = 0.1 s, a vehicle turning both ways
+// Also, the RTS smoother over a recorded 1024-frame run (time per call; the
+// counter `frame` is the time per frame):
+//   BM_RtsSmooth_<Model>/posefuse     posefuse::rts_smooth
+//   BM_RtsSmooth_<Model>/naive_fixed  the textbook backward pass in fixed-size
+//                                     Eigen, C = P F^T Pbar^-1 with .inverse()
+//   for Model = ConstantVelocity (4 states) and Ctrv (5 states); both agree to
+//   1e-9 before timing.
 // Also:
 //   BM_PsdCheck/<n>            is_positive_semidefinite() alone on covariances
 //                              those filters produce (n = 2, 4, 15)
@@ -48,7 +57,9 @@
 #include <benchmark/benchmark.h>
 #include <posefuse/core/angles.hpp>
 #include <posefuse/filters/ekf.hpp>
+#include <posefuse/filters/rts_smoother.hpp>
 #include <posefuse/models/constant_velocity.hpp>
+#include <posefuse/models/ctrv.hpp>
 #include <posefuse/models/planar_displacement.hpp>
 #include <posefuse/models/planar_pose_fix.hpp>
 #include <posefuse/models/position.hpp>
@@ -610,6 +621,194 @@ struct Pose15 : Euclidean {
   };
 };
 
+
+// ---------------------------------------------------------------------------
+// Constant turn rate and velocity + position fix
+
+struct CtrvEkf {
+  static constexpr double kDt = 0.1, kQa = 0.5, kQw = 0.05, kSigma = 0.5;
+  using State = posefuse::CtrvState<double>;
+  using Vec5 = Eigen::Matrix<double, 5, 1>;
+  using Mat5 = Eigen::Matrix<double, 5, 5>;
+  static const std::vector<Eigen::Vector2d>& measurements() {
+    static const std::vector<Eigen::Vector2d> zs = []() __attribute__((noinline)) {
+      std::vector<Eigen::Vector2d> out;
+      std::mt19937 rng(9);
+      std::normal_distribution<double> n(0.0, 1.0);
+      const posefuse::Ctrv<double> m(kQa, kQw);
+      State x(0, 0, 0.3, 8.0, 0.0);
+      for (std::size_t k = 0; k < kFrames; ++k) {
+        // speed and yaw rate wander; the yaw rate crosses zero both ways
+        x.values(3) = 8.0 + 2.0 * std::sin(double(k) / 90.0) + 0.05 * n(rng);
+        x.values(4) = 0.4 * std::sin(double(k) / 40.0) + 0.01 * n(rng);
+        x = m.predict(x, {}, kDt);
+        const double ex = n(rng);
+        const double ey = n(rng);
+        out.push_back(x.position() + kSigma * Eigen::Vector2d(ex, ey));
+      }
+      return out;
+    }();
+    return zs;
+  }
+  static State x0() { return State(measurements()[0].x(), measurements()[0].y(), 0.3, 8.0, 0.0); }
+  static Mat5 P0() { return Vec5(1.0, 1.0, 0.1, 1.0, 0.01).asDiagonal(); }
+  static posefuse::Ctrv<double> motion() { return posefuse::Ctrv<double>(kQa, kQw); }
+  static double difference(const VectorXd& a, const VectorXd& b) {
+    VectorXd d = a - b;
+    d(2) = posefuse::angle_diff(a(2), b(2));
+    return d.cwiseAbs().maxCoeff() / (1.0 + b.cwiseAbs().maxCoeff());
+  }
+  template <class Options>
+  struct Filter {
+    posefuse::BasicEkf<Options, posefuse::Ctrv<double>, posefuse::CtrvPositionFix<double>> ekf{
+        motion(), posefuse::CtrvPositionFix<double>::isotropic(kSigma)};
+    Filter() { ekf.reset(x0(), P0()); }
+    posefuse::FilterStatus step(std::size_t k) {
+      (void)ekf.predict(posefuse::NoControl{}, kDt);
+      return ekf.template update<0>(measurements()[k]).status;
+    }
+    VectorXd state() const { return ekf.state().vector(); }
+  };
+  using Posefuse = Filter<posefuse::EkfOptions>;
+  using PosefuseNoMemo = Filter<NoMemo>;
+  /// The textbook step on the model's f, F and Q (heading wrapped after the update).
+  struct Naive {
+    Vec5 mu = x0().vector();
+    Mat5 S = P0();
+    double step(std::size_t k) {
+      const posefuse::Ctrv<double> m = motion();
+      const State x(mu);
+      const Vec5 mubar = m.predict(x, {}, kDt).vector();
+      const Mat5 G = m.jacobian(x, {}, kDt);
+      Eigen::Matrix<double, 2, 5> H = Eigen::Matrix<double, 2, 5>::Zero();
+      H(0, 0) = H(1, 1) = 1;
+      const Eigen::Matrix2d R = Eigen::Matrix2d::Identity() * (kSigma * kSigma);
+      const Mat5 Sbar = G * S * G.transpose() + m.noise(x, {}, kDt);
+      const Eigen::Matrix<double, 5, 2> K = Sbar * H.transpose() * (H * Sbar * H.transpose() + R).inverse();
+      mu = mubar + K * (measurements()[k] - H * mubar);
+      mu(2) = posefuse::wrap_angle(mu(2));
+      S = (Mat5::Identity() - K * H) * Sbar;
+      return S(0, 0);
+    }
+    VectorXd state() const { return mu; }
+  };
+  struct Dynamic {
+    VectorXd mu = x0().vector();
+    MatrixXd S = P0();
+    double step(std::size_t k) {
+      const posefuse::Ctrv<double> m = motion();
+      const State x{Vec5(mu)};
+      const VectorXd mubar = m.predict(x, {}, kDt).vector();
+      const MatrixXd G = m.jacobian(x, {}, kDt);
+      const MatrixXd Q = m.noise(x, {}, kDt);
+      MatrixXd H = MatrixXd::Zero(2, 5);
+      H(0, 0) = H(1, 1) = 1;
+      const MatrixXd R = MatrixXd::Identity(2, 2) * (kSigma * kSigma);
+      const VectorXd z = measurements()[k];
+      const MatrixXd Sbar = G * S * G.transpose() + Q;
+      const MatrixXd Sinn = H * Sbar * H.transpose() + R;
+      const MatrixXd K = Sbar * H.transpose() * Sinn.inverse();
+      mu = mubar + K * (z - H * mubar);
+      mu(2) = posefuse::wrap_angle(mu(2));
+      S = (MatrixXd::Identity(5, 5) - K * H) * Sbar;
+      return S(0, 0);
+    }
+    VectorXd state() const { return mu; }
+  };
+};
+
+// ---------------------------------------------------------------------------
+// RTS smoothing of a recorded run
+
+/// A recorded forward run (kFrames steps) of workload W's posefuse filter.
+template <class W, class S>
+const std::vector<posefuse::SmootherStep<S>>& recorded_run() {
+  static const std::vector<posefuse::SmootherStep<S>> run = []() __attribute__((noinline)) {
+    std::vector<posefuse::SmootherStep<S>> out;
+    typename W::Posefuse f;
+    for (std::size_t k = 0; k < kFrames; ++k) {
+      posefuse::SmootherStep<S> st;
+      if (k > 0) (void)f.ekf.predict(posefuse::NoControl{}, W::dt_of(k));
+      st.predicted_mean = f.ekf.state();
+      st.predicted_cov = f.ekf.covariance();
+      if (k > 0) st.F = f.ekf.last_jacobian();
+      (void)f.ekf.template update<0>(W::z_of(k));
+      st.filtered_mean = f.ekf.state();
+      st.filtered_cov = f.ekf.covariance();
+      out.push_back(st);
+    }
+    return out;
+  }();
+  return run;
+}
+
+struct RtsCv : ConstantVelocity<false> {
+  using S = Eigen::Vector4d;
+  static double dt_of(std::size_t k) { return dt(k); }
+  static Eigen::Vector2d z_of(std::size_t k) { return z(k); }
+  static VectorXd vec(const S& x) { return x; }
+  static S add(const S& x, const VectorXd& d) { return x + d; }
+  static VectorXd sub(const S& a, const S& b) { return a - b; }
+};
+struct RtsCtrv : CtrvEkf {
+  using S = posefuse::CtrvState<double>;
+  static double dt_of(std::size_t) { return kDt; }
+  static Eigen::Vector2d z_of(std::size_t k) { return measurements()[k]; }
+  static VectorXd vec(const S& x) { return x.vector(); }
+  static S add(const S& x, const Vec5& d) { return x.plus(d); }
+  static Vec5 sub(const S& a, const S& b) { return a.minus(b); }
+};
+
+/// The textbook backward pass, fixed-size Eigen, explicit inverse.
+template <class W>
+std::vector<Eigen::Matrix<double, posefuse::DimOf<typename W::S>, 1>> naive_rts(
+    const std::vector<posefuse::SmootherStep<typename W::S>>& run) {
+  using S = typename W::S;
+  constexpr int N = posefuse::DimOf<S>;
+  using Vec = Eigen::Matrix<double, N, 1>;
+  using Mat = Eigen::Matrix<double, N, N>;
+  std::vector<Vec> out(run.size());
+  S xs = run.back().filtered_mean;
+  Mat Ps = run.back().filtered_cov;
+  out.back() = W::vec(xs);
+  for (std::size_t k = run.size() - 1; k-- > 0;) {
+    const Mat C = run[k].filtered_cov * run[k + 1].F.transpose() * run[k + 1].predicted_cov.inverse();
+    xs = W::add(run[k].filtered_mean, Vec(C * Vec(W::sub(xs, run[k + 1].predicted_mean))));
+    Ps = run[k].filtered_cov + C * (Ps - run[k + 1].predicted_cov) * C.transpose();
+    out[k] = W::vec(xs);
+  }
+  return out;
+}
+
+template <class W>
+std::string rts_disagreement() {
+  const auto& run = recorded_run<W, typename W::S>();
+  const auto a = posefuse::rts_smooth(run);
+  const auto b = naive_rts<W>(run);
+  for (std::size_t k = 0; k < run.size(); ++k)
+    if (!(W::difference(W::vec(a[k].mean), b[k]) <= 1e-9)) return "rts_smooth differs from naive_fixed";
+  return {};
+}
+
+template <class W, bool kPosefuse>
+void BM_Rts(benchmark::State& st) {
+  static const std::string why = rts_disagreement<W>();
+  if (!why.empty()) {
+    st.SkipWithError(why.c_str());
+    return;
+  }
+  const auto& run = recorded_run<W, typename W::S>();
+  for (auto _ : st) {
+    if constexpr (kPosefuse) {
+      benchmark::DoNotOptimize(posefuse::rts_smooth(run).front().mean);
+    } else {
+      benchmark::DoNotOptimize(naive_rts<W>(run).front());
+    }
+  }
+  st.counters["frame"] = benchmark::Counter(double(run.size()), benchmark::Counter::kIsIterationInvariantRate |
+                                                                    benchmark::Counter::kInvert);
+}
+
 // ---------------------------------------------------------------------------
 // Registration
 
@@ -687,6 +886,11 @@ const bool registered = [] {
   register_workload<ConstantVelocity<true>>("BM_ConstantVelocityKitti_Step", false);
   register_workload<UnicyclePoseFix>("BM_UnicyclePoseFix_Step", false);
   register_workload<Pose15>("BM_Pose15_Step", true);
+  register_workload<CtrvEkf>("BM_CtrvEkf_Step", false);
+  benchmark::RegisterBenchmark("BM_RtsSmooth_ConstantVelocity/posefuse", BM_Rts<RtsCv, true>);
+  benchmark::RegisterBenchmark("BM_RtsSmooth_ConstantVelocity/naive_fixed", BM_Rts<RtsCv, false>);
+  benchmark::RegisterBenchmark("BM_RtsSmooth_Ctrv/posefuse", BM_Rts<RtsCtrv, true>);
+  benchmark::RegisterBenchmark("BM_RtsSmooth_Ctrv/naive_fixed", BM_Rts<RtsCtrv, false>);
   benchmark::RegisterBenchmark("BM_PsdCheck/2", BM_PsdCheck<2>);
   benchmark::RegisterBenchmark("BM_PsdCheck/4", BM_PsdCheck<4>);
   benchmark::RegisterBenchmark("BM_PsdCheck/15", BM_PsdCheck<15>);
