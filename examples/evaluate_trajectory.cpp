@@ -49,6 +49,7 @@
 #include <vector>
 
 #include <apps/cli.hpp>
+#include <apps/evaluation.hpp>
 #include <apps/json.hpp>
 #include <apps/output_file.hpp>
 #include <apps/progress.hpp>
@@ -64,25 +65,11 @@ namespace {
 
 namespace apps = posefuse::apps;
 
-struct Options {
+// The evaluation's own settings (apps/evaluation.hpp) and the program's files and outputs.
+struct Options : apps::EvaluationSetup {
   std::filesystem::path groundtruth, estimate;
   std::optional<std::filesystem::path> times, save_results, plot;
   posefuse::Plane plot_mode = posefuse::Plane::kXY;
-  // Given by --format / --groundtruth-format / --estimate-format, or
-  // detected from the file's content (resolve_formats) when not given.
-  std::optional<posefuse::Format> ref_format_given, est_format_given;
-  posefuse::Format ref_format = posefuse::Format::kKitti;
-  posefuse::Format est_format = posefuse::Format::kKitti;
-  posefuse::DuplicateStamps duplicates = posefuse::DuplicateStamps::kFirst;
-  bool metric_rpe = false;
-  posefuse::PoseRelation relation = posefuse::PoseRelation::kTranslation;
-  posefuse::RpeOptions rpe;  // delta, unit, all pairs, tolerance, pair source
-  posefuse::AlignmentOptions align;
-  double max_time_diff = 0.01;
-  double t_offset = 0.0;
-  std::optional<double> t_start, t_end;
-  std::optional<std::size_t> downsample;
-  std::optional<std::pair<double, double>> motion_filter;  // m, deg
   bool json = false;
 };
 
@@ -131,9 +118,10 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
              format_flag(est_format));
   cli.path({.name = "--times", .value = "FILE", .help = "KITTI times.txt, stamps every KITTI file given"},
            o.times);
-  cli.custom({.name = "--duplicates", .value = "first|last|error",
+  cli.custom({.name = "--duplicates", .value = "first|last|keep|error",
               .help = "equal consecutive stamps: keep the first or last pose (reported\n"
-                      "as a warning) or refuse the file",
+                      "as a warning), keep every pose as evo does (each repeat pairs\n"
+                      "with its nearest partner) or refuse the file",
               .default_text = "first"},
              [&](std::string_view v) { o.duplicates = posefuse::parse_duplicate_stamps(v); });
   cli.custom({.name = "--metric", .value = "ape|rpe", .help = "the error", .default_text = "ape"},
@@ -214,6 +202,8 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   if (!ref || !est) throw apps::usage_error("--groundtruth and --estimate are required");
   o.groundtruth = *ref;
   o.estimate = *est;
+  o.groundtruth_name = o.groundtruth.string();
+  o.estimate_name = o.estimate.string();
   {
     std::vector<std::pair<std::string, std::filesystem::path>> outputs, inputs{{"--groundtruth", o.groundtruth},
                                                                              {"--estimate", o.estimate}};
@@ -251,13 +241,7 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   return o;
 }
 
-/// A file's trajectory and, for a TUM estimate with covariance columns, the
-/// covariance of each pose (empty otherwise).
-struct Loaded {
-  posefuse::Trajectory trajectory;
-  int covariance_dim = 0;
-  std::vector<Eigen::Matrix<double, 6, 6>> covariance;
-};
+using Loaded = apps::LoadedTrajectory;
 
 /// Reads one trajectory file (and, for KITTI, its times) into `out`.
 void read_into(Loaded& out, const std::filesystem::path& file, posefuse::Format format,
@@ -287,34 +271,12 @@ Loaded load(const std::filesystem::path& file, posefuse::Format format,
   try {
     read_into(out, file, format, times, options, report, allow_covariance);
   } catch (const posefuse::repeated_stamp_error& e) {  // this program offers the other policies
-    throw apps::data_error(std::string(e.what()) + "; repeated stamps can be kept first or last instead (--duplicates)");
+    throw apps::data_error(std::string(e.what()) + "; repeated stamps can be kept first, last or all instead (--duplicates)");
   }
-  if (report.duplicates_dropped > 0) {
-    const std::filesystem::path& where = format == posefuse::Format::kKitti ? *times : file;
-    warnings.push_back(where.string() + ":" + std::to_string(report.first_duplicate_line) +
-                       ": " + std::to_string(report.duplicates_dropped) +
-                       " pose(s) with a repeated timestamp dropped (kept the " +
-                       std::string(posefuse::to_string(duplicates)) +
-                       " of each run; --duplicates error refuses them)");
-  }
+  // Repeats are only possible in a KITTI times file, never in a KITTI pose file.
+  const std::filesystem::path& where = format == posefuse::Format::kKitti && times ? *times : file;
+  for (std::string& w : apps::duplicate_warnings(where.string(), report, duplicates)) warnings.push_back(std::move(w));
   return out;
-}
-
-/// NEES of the associated estimate, when its file carried covariances (APE only).
-std::optional<posefuse::NeesResult> consistency(const Options& o, const Loaded& est_file,
-                                                const posefuse::Trajectory& ref_sync,
-                                                const posefuse::Trajectory& est_sync,
-                                                const posefuse::MetricResult& result) {
-  if (est_file.covariance_dim == 0 || o.metric_rpe) return std::nullopt;
-  // Associated poses keep their file's stamps: find each one's covariance.
-  std::vector<Eigen::Matrix<double, 6, 6>> covariance;
-  covariance.reserve(est_sync.size());
-  const std::vector<double>& stamps = est_file.trajectory.t_s;
-  for (const double t : est_sync.t_s) {
-    const auto it = std::lower_bound(stamps.begin(), stamps.end(), t);
-    covariance.push_back(est_file.covariance[static_cast<std::size_t>(it - stamps.begin())]);
-  }
-  return posefuse::nees(ref_sync, est_sync, covariance, est_file.covariance_dim, result.alignment);
 }
 
 std::string relation_title(posefuse::PoseRelation r) {
@@ -328,16 +290,6 @@ std::string relation_title(posefuse::PoseRelation r) {
     case posefuse::PoseRelation::kPointDistanceErrorRatio: return "point distance error ratio (%)";
   }
   return "?";
-}
-
-/// The --pose-relation spelling ("trans" for the translation part).
-std::string_view relation_name(posefuse::PoseRelation r) {
-  return r == posefuse::PoseRelation::kTranslation ? "trans" : posefuse::to_string(r);
-}
-
-std::string alignment_name(const Options& o) {
-  if (o.align.align_origin) return "origin";
-  return std::string(posefuse::to_string(o.align.alignment));
 }
 
 void print_table(const Options& o, const posefuse::MetricResult& r,
@@ -378,87 +330,13 @@ void print_table(const Options& o, const posefuse::MetricResult& r,
   }
 }
 
-/// The summary members shared by --json and --save-results.
-void write_summary(apps::JsonWriter& j, const Options& o, const posefuse::MetricResult& r,
-                   const std::optional<posefuse::NeesResult>& nees) {
-  const posefuse::Statistics& s = r.stats;
-  j.member("metric", o.metric_rpe ? "rpe" : "ape")
-      .member("groundtruth_format", posefuse::to_string(o.ref_format))
-      .member("estimate_format", posefuse::to_string(o.est_format))
-      .member("formats_detected", !o.ref_format_given || !o.est_format_given)
-      .member("pose_relation", relation_name(o.relation))
-      .member("unit", posefuse::unit_of(o.relation))
-      .member("alignment", alignment_name(o))
-      .member("scale", r.alignment.scale);
-  if (o.metric_rpe) {
-    j.member("delta", o.rpe.delta).member("delta_unit", posefuse::to_string(o.rpe.delta_unit));
-  }
-  j.member("count", s.count).member("rmse", s.rmse).member("mean", s.mean).member("median", s.median);
-  j.member("std", s.std).member("min", s.min).member("max", s.max).member("sse", s.sse);
-  if (nees) {
-    j.member("nees_mean", nees->mean).member("nees_dim", nees->dim);
-    j.member("nees_lower", nees->lower).member("nees_upper", nees->upper);
-    j.member("nees_consistent", nees->consistent());
-  }
-}
-
 /// One JSON object on one line; numbers round-trip, non-finite ones are null.
 void print_json(const Options& o, const posefuse::MetricResult& r,
                 const std::optional<posefuse::NeesResult>& nees) {
   apps::JsonWriter j(std::cout);
   j.begin_object(apps::JsonWriter::Layout::kInline);
-  write_summary(j, o, r, nees);
+  apps::write_summary(j, o, r, nees);
   j.end_object().finish();
-}
-
-/// The --save-results document: the summary, the options that shaped it,
-/// and per pose (APE) or pair (RPE) the stamp(s) and the error.
-std::string results_json(const Options& o, const posefuse::MetricResult& r,
-                         const std::optional<posefuse::NeesResult>& nees,
-                         const posefuse::Trajectory& ref_used,
-                         const std::vector<std::string>& warnings) {
-  std::ostringstream out;
-  apps::JsonWriter j(out);
-  j.begin_object();
-  write_summary(j, o, r, nees);
-  j.key("options").begin_object();
-  j.member("groundtruth", o.groundtruth.string()).member("estimate", o.estimate.string());
-  j.member("duplicates", posefuse::to_string(o.duplicates));
-  j.member("n_to_align", o.align.n_to_align);
-  j.member("project_to_plane",
-           o.align.project_to_plane ? posefuse::to_string(*o.align.project_to_plane) : "none");
-  j.member("max_time_diff_s", o.max_time_diff).member("t_offset_s", o.t_offset);
-  j.member("t_start_s", o.t_start ? *o.t_start : std::nan(""))
-      .member("t_end_s", o.t_end ? *o.t_end : std::nan(""));
-  j.member("downsample", o.downsample ? static_cast<double>(*o.downsample) : std::nan(""));
-  j.member("motion_filter_m", o.motion_filter ? o.motion_filter->first : std::nan(""))
-      .member("motion_filter_deg", o.motion_filter ? o.motion_filter->second : std::nan(""));
-  if (o.metric_rpe) {
-    j.member("all_pairs", o.rpe.all_pairs).member("delta_tol", o.rpe.delta_tol);
-    j.member("pairs_from_reference", o.rpe.pairs_from_reference);
-  }
-  j.end_object();
-  j.key("warnings").begin_array();
-  for (const std::string& w : warnings) j.value(w);
-  j.end_array();
-  j.key("errors").begin_array();
-  for (const double e : r.errors) j.value(e);
-  j.end_array();
-  if (nees) {
-    j.key("nees").begin_array();
-    for (const double e : nees->nees) j.value(e);
-    j.end_array();
-  }
-  // Stamps of the reference pose each error belongs to (RPE: the pair's end).
-  j.key("stamps_s").begin_array();
-  if (o.metric_rpe) {
-    for (const auto& pair : r.pairs) j.value(ref_used.t_s[pair.second]);
-  } else {
-    for (const double t : ref_used.t_s) j.value(t);
-  }
-  j.end_array();
-  j.end_object().finish();
-  return out.str();
 }
 
 /// The --plot document: top, the trajectories in the chosen plane (REF
@@ -524,8 +402,7 @@ std::string plot_svg(const Options& o, const posefuse::MetricResult& r,
     flush();
   }
   // KITTI files without --times carry frame indices, not times.
-  const bool indices = o.ref_format == posefuse::Format::kKitti &&
-                       o.est_format == posefuse::Format::kKitti && !o.times;
+  const bool indices = o.frame_by_frame();
   svg::Plot over_time(metric + (indices ? " per pose (" : " over time (") +
                       std::to_string(r.stats.count) + " values)");
   if (indices) {
@@ -555,16 +432,6 @@ std::string plot_svg(const Options& o, const posefuse::MetricResult& r,
   return doc.str();
 }
 
-posefuse::Trajectory thin(const posefuse::Trajectory& traj, const Options& o) {
-  posefuse::Trajectory out = traj;
-  if (o.downsample) out = posefuse::downsample(out, *o.downsample);
-  if (o.motion_filter) {
-    out = posefuse::motion_filter(out, o.motion_filter->first,
-                                  o.motion_filter->second * std::numbers::pi / 180.0);
-  }
-  return out;
-}
-
 /// Fills in the formats not given on the command line from the files'
 /// content, then checks what depends on them (usage errors, exit 2).
 /// `ref_path`, `est_path`: where the files are read from (see run).
@@ -580,9 +447,8 @@ Options resolve_formats(Options o, const std::filesystem::path& ref_path, const 
                                                                 ? o.est_format
                                                                 : o.ref_format)) +
                             " file needs --times for the KITTI one");
-  const bool frame_by_frame = o.ref_format == posefuse::Format::kKitti &&
-                              o.est_format == posefuse::Format::kKitti && !o.times;
-  if (frame_by_frame && (o.motion_filter || o.t_start || o.t_end || o.t_offset != 0.0))
+  o.stamped_by_times = o.times.has_value();
+  if (o.frame_by_frame() && (o.motion_filter || o.t_start || o.t_end || o.t_offset != 0.0))
     throw apps::usage_error(
         "--motion-filter, --t-start, --t-end and --t-offset need timestamps: give --times "
         "(KITTI files without it are compared frame by frame)");
@@ -600,8 +466,8 @@ int run_read(const Options& given, apps::SpooledInputs& spool) {
   apps::TerminalProgress progress("evaluate_trajectory");
   std::vector<std::string> warnings;
   progress.stage("reading " + o.groundtruth.string());
-  const posefuse::Trajectory ref_file =
-      load(ref_path, o.ref_format, o.times, o.duplicates, false, warnings).trajectory;
+  const Loaded ref_loaded = load(ref_path, o.ref_format, o.times, o.duplicates, false, warnings);
+  const posefuse::Trajectory& ref_file = ref_loaded.trajectory;
   progress.stage("reading " + o.estimate.string());
   const Loaded est_loaded = load(est_path, o.est_format, o.times, o.duplicates, true, warnings);
   const posefuse::Trajectory& est_file = est_loaded.trajectory;
@@ -610,72 +476,13 @@ int run_read(const Options& given, apps::SpooledInputs& spool) {
   for (const std::string& w : warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   progress.stage("associating " + std::to_string(ref_file.size()) + " and " + std::to_string(est_file.size()) +
                  " poses");
-  // Thinned copies only when thinning is asked for; otherwise the poses as
-  // read are used (no copy of a possibly large file).
-  const bool thinning = o.downsample.has_value() || o.motion_filter.has_value();
-  posefuse::Trajectory ref_kept, est_kept;
-  if (thinning) {
-    ref_kept = thin(ref_file, o);
-    est_kept = thin(est_file, o);
-  }
-  const posefuse::Trajectory* ref = thinning ? &ref_kept : &ref_file;
-  const posefuse::Trajectory& est = thinning ? est_kept : est_file;
-  posefuse::Trajectory ref_sync, est_sync;
-  const bool frame_by_frame = o.ref_format == posefuse::Format::kKitti &&
-                              o.est_format == posefuse::Format::kKitti && !o.times;
-  if (frame_by_frame) {
-    if (ref->size() != est.size()) {
-      throw apps::data_error("reference has " + std::to_string(ref->size()) +
-                             " poses but estimate " + std::to_string(est.size()) +
-                             "; KITTI files without --times are compared frame by frame");
-    }
-    ref_sync = *ref;
-    est_sync = est;
-  } else {
-    if (o.t_start || o.t_end) {
-      ref_kept = posefuse::reduce_to_time_range(*ref, o.t_start, o.t_end);
-      ref = &ref_kept;
-      if (ref->empty()) {
-        throw apps::data_error(o.groundtruth.string() + ": no pose between --t-start and --t-end (" +
-                               apps::shortest(ref_file.t_s.front()) + " to " +
-                               apps::shortest(ref_file.t_s.back()) + " s in the file)");
-      }
-    }
-    posefuse::AssociatedTrajectories sync = posefuse::associate(*ref, est, o.max_time_diff, o.t_offset);
-    ref_sync = std::move(sync.ref);
-    est_sync = std::move(sync.est);
-  }
-  if (o.align.n_to_align > ref_sync.size()) {
-    throw apps::data_error("--n-to-align " + std::to_string(o.align.n_to_align) + " but only " +
-                           std::to_string(ref_sync.size()) + " poses are associated");
-  }
-  progress.stage(std::string(o.metric_rpe ? "RPE" : "APE") + " of " + std::to_string(ref_sync.size()) +
-                 " pose pairs");
-  posefuse::MetricResult result;
-  try {
-    result = o.metric_rpe ? posefuse::rpe(ref_sync, est_sync, o.rpe)
-                          : posefuse::ape(ref_sync, est_sync, o.relation, o.align);
-  } catch (const posefuse::invalid_argument& e) {
-    // The library's reason names its function; say what it means for the files.
-    const std::string what = e.what();
-    const std::string files = o.groundtruth.string() + " and " + o.estimate.string();
-    if (what.find("degenerate") != std::string::npos || what.find("no horizontal spread") != std::string::npos)
-      throw apps::data_error(files + ": the " + std::to_string(ref_sync.size()) +
-                             " associated positions are all at one point or on one line, so --align " +
-                             std::string(posefuse::to_string(o.align.alignment)) +
-                             " has no unique answer (use --align none)");
-    if (what.find("not finite") != std::string::npos)
-      throw apps::data_error(files + ": an error is not finite (positions too large to be compared)");
-    throw apps::data_error(files + ": " + what.substr(what.find(':') == std::string::npos ? 0 : what.find(':') + 2));
-  }
-  if (o.align.project_to_plane && est_loaded.covariance_dim > 0 && !o.metric_rpe)
-    throw apps::usage_error("NEES (an estimate with covariance) cannot be combined with --project-to-plane");
-  const std::optional<posefuse::NeesResult> nees =
-      consistency(o, est_loaded, ref_sync, est_sync, result);
+  const apps::Evaluation evaluation = apps::evaluate(o, ref_loaded, est_loaded);
+  const posefuse::MetricResult& result = evaluation.result;
+  const std::optional<posefuse::NeesResult>& nees = evaluation.nees;
   progress.clear();
   apps::OutputFiles outputs;
-  if (o.save_results) outputs.add(*o.save_results, results_json(o, result, nees, ref_sync, warnings));
-  if (o.plot) outputs.add(*o.plot, plot_svg(o, result, ref_sync, est_sync));
+  if (o.save_results) outputs.add(*o.save_results, apps::results_json(o, evaluation, warnings));
+  if (o.plot) outputs.add(*o.plot, plot_svg(o, result, evaluation.ref_used, evaluation.est_used));
   outputs.commit();
   if (o.json) {
     print_json(o, result, nees);

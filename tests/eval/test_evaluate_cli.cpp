@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <iterator>
 #include <numbers>
+#include <sstream>
 #include <fstream>
 #include <string>
 #include <utility>
@@ -234,7 +235,7 @@ TEST_CASE("Evaluate CLI: evo options reach the library unchanged", "[eval][cli][
          {files + " --align-origin --align se3", files + " --n-to-align 10",
           files + " --n-to-align 2 --align se3", files + " --pose-relation point_distance_error_ratio",
           files + " --t-start 5 --t-end 4", files + " --downsample 0", files + " --motion-filter 1",
-          files + " --motion-filter 1,-2", files + " --duplicates keep", files + " --delta-tol -1"}) {
+          files + " --motion-filter 1,-2", files + " --duplicates all", files + " --delta-tol -1"}) {
       INFO(args);
       const Run r = run(exe, args, dir);
       CHECK(r.status == 2);
@@ -267,6 +268,29 @@ TEST_CASE("Evaluate CLI: repeated stamps, byte-order marks and stamp units", "[e
   CHECK(Json::parse(first.out)["rmse"].number() == 0.0);
   const Run last = run(exe, files + " --duplicates last --json", dir);
   CHECK(last.status == 0);
+  // keep (evo): the repeats are in the longer file here, so each reference
+  // stamp still pairs with the first pose of the run: 50 pairs, as first.
+  const Run keep = run(exe, files + " --duplicates keep --json", dir);
+  REQUIRE(keep.status == 0);
+  CHECK(keep.err.rfind("warning: " + (dir.path() / "dup.tum").string() + ":12: 2 pose(s) with a repeated timestamp kept", 0) == 0);
+  CHECK(Json::parse(keep.out)["count"].number() == 50.0);
+  {
+    // A shorter estimate with the repeats: under keep every repeated line is
+    // a pair of its own (evo's association walks the shorter file).
+    std::istringstream all(text);
+    std::string short_text;
+    for (int k = 0; k < 33 && std::getline(all, line); ++k) short_text += line + "\n";  // a header, 32 poses
+    std::ofstream(dir.path() / "dup_short.tum") << short_text;
+    const std::string short_files = "--format tum --groundtruth '" + (dir.path() / "ref.tum").string() +
+                                    "' --estimate '" + (dir.path() / "dup_short.tum").string() + "' --json";
+    const Run kept = run(exe, short_files + " --duplicates keep", dir);
+    REQUIRE(kept.status == 0);
+    CHECK(Json::parse(kept.out)["count"].number() == 32.0);
+    CHECK(Json::parse(kept.out)["rmse"].number() == 0.0);
+    const Run dropped = run(exe, short_files, dir);
+    REQUIRE(dropped.status == 0);
+    CHECK(Json::parse(dropped.out)["count"].number() == 30.0);
+  }
   const Run refused = run(exe, files + " --duplicates error", dir);
   CHECK(refused.status == 1);
   CHECK(refused.err.find("dup.tum:12: timestamp") != std::string::npos);

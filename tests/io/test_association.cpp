@@ -156,3 +156,51 @@ TEST_CASE("Association: trajectories are reduced to the matched poses", "[io][as
   broken.t_s[1] = broken.t_s[0];
   CHECK_THROWS_AS(posefuse::associate(ref, broken), posefuse::invalid_argument);
 }
+
+TEST_CASE("Association: DuplicateStamps::kKeep reproduces evo on repeated stamps",
+          "[io][association][duplicates]") {
+  // evo reads every line (no duplicate policy) and associate_trajectories
+  // walks the shorter trajectory: here the estimate (6 poses, stamp 2
+  // repeated) against a 10-pose reference. Each repeated estimate stamp
+  // pairs with its nearest reference pose, so reference pose 2 is used
+  // twice. APE without alignment, by hand: errors 0, 0.1, 0.2, 0.4, 0, 0,
+  // rmse = sqrt(0.21 / 6).
+  posefuse::Trajectory ref, est;
+  for (int k = 0; k < 10; ++k) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.translation() = Eigen::Vector3d(k, 0.0, 0.0);
+    ref.push_back(k, T);
+  }
+  const double stamps[] = {0, 1, 2, 2, 3, 4};
+  const double dy[] = {0.0, 0.1, 0.2, 0.4, 0.0, 0.0};
+  for (int k = 0; k < 6; ++k) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.translation() = Eigen::Vector3d(stamps[k], dy[k], 0.0);
+    est.push_back(stamps[k], T);
+  }
+  // Other policies refuse trajectories with equal stamps (the readers have
+  // already dropped the repeats).
+  CHECK_THROWS_AS(posefuse::associate(ref, est), posefuse::invalid_argument);
+  const posefuse::AssociatedTrajectories sync =
+      posefuse::associate(ref, est, 0.01, 0.0, posefuse::DuplicateStamps::kKeep);
+  REQUIRE(sync.ref.size() == 6);
+  CHECK(sync.ref.t_s == std::vector<double>{0, 1, 2, 2, 3, 4});
+  CHECK(sync.est.poses[3].translation().y() == 0.4);
+  double sse = 0.0;
+  for (std::size_t k = 0; k < 6; ++k)
+    sse += (sync.ref.poses[k].translation() - sync.est.poses[k].translation()).squaredNorm();
+  CHECK(std::sqrt(sse / 6.0) == Approx(std::sqrt(0.21 / 6.0)).epsilon(1e-15));
+
+  // The repeats in the longer trajectory: each shorter stamp takes the first
+  // pose of the run (np.argmin's first minimum).
+  posefuse::Trajectory short_ref;
+  for (int k = 0; k < 4; ++k) short_ref.push_back(k, ref.poses[static_cast<std::size_t>(k)]);
+  const posefuse::Association a = posefuse::associate(short_ref.t_s, est.t_s, 0.01, 0.0);
+  CHECK(a.est_ids == Ids{0, 1, 2, 4});
+
+  // Decreasing stamps stay an error.
+  posefuse::Trajectory bad = est;
+  bad.t_s[4] = 1.5;
+  CHECK_THROWS_WITH(posefuse::associate(ref, bad, 0.01, 0.0, posefuse::DuplicateStamps::kKeep),
+                    Catch::Contains("decrease at index 4"));
+}

@@ -464,9 +464,21 @@ TEST_CASE("Formats: TUM repeated stamps follow the duplicate policy and are repo
     CHECK(traj.poses[2].translation().x() == 6.0);
     CHECK(report.duplicates_dropped == 3);
   }
+  SECTION("keep keeps every pose, equal stamps and all (as evo reads)") {
+    options.duplicates = posefuse::DuplicateStamps::kKeep;
+    posefuse::ReadReport report;
+    const posefuse::Trajectory traj = posefuse::read_tum(file, options, &report);
+    REQUIRE(traj.size() == 6);
+    CHECK(traj.t_s == std::vector<double>{0.1, 0.1, 0.1, 0.2, 0.3, 0.3});
+    CHECK(traj.poses[1].translation().x() == 2.0);
+    CHECK(report.duplicates_kept == 3);
+    CHECK(report.duplicates_dropped == 0);
+    CHECK(report.first_duplicate_line == 3);
+  }
   SECTION("a decreasing stamp stays an error under every policy") {
     const auto bad = dir.write("b.tum", "0.1 1 0 0 0 0 0 1\n0.1 2 0 0 0 0 0 1\n0.05 3 0 0 0 0 0 1\n");
-    for (const auto policy : {posefuse::DuplicateStamps::kFirst, posefuse::DuplicateStamps::kLast}) {
+    for (const auto policy : {posefuse::DuplicateStamps::kFirst, posefuse::DuplicateStamps::kLast,
+                              posefuse::DuplicateStamps::kKeep}) {
       options.duplicates = policy;
       check_error(expect_io_error([&] { (void)posefuse::read_tum(bad, options); }), bad, 3,
                   "timestamp 0.05 is earlier than the previous one (0.1 on line 2)");
@@ -477,7 +489,9 @@ TEST_CASE("Formats: TUM repeated stamps follow the duplicate policy and are repo
     CHECK(posefuse::parse_duplicate_stamps("last") == posefuse::DuplicateStamps::kLast);
     CHECK(posefuse::parse_duplicate_stamps("error") == posefuse::DuplicateStamps::kError);
     CHECK(posefuse::to_string(posefuse::DuplicateStamps::kLast) == "last");
-    CHECK_THROWS_AS(posefuse::parse_duplicate_stamps("keep"), posefuse::invalid_argument);
+    CHECK(posefuse::parse_duplicate_stamps("keep") == posefuse::DuplicateStamps::kKeep);
+    CHECK(posefuse::to_string(posefuse::DuplicateStamps::kKeep) == "keep");
+    CHECK_THROWS_AS(posefuse::parse_duplicate_stamps("all"), posefuse::invalid_argument);
   }
 }
 

@@ -21,6 +21,7 @@
 
 #include <posefuse/core/error.hpp>
 #include <posefuse/io/detail/text.hpp>
+#include <posefuse/io/read_options.hpp>
 #include <posefuse/core/trajectory.hpp>
 
 namespace posefuse {
@@ -169,12 +170,40 @@ template <class Lazy = void>
   return a;
 }
 
+namespace detail::traj_io {
+
+/// `Trajectory::validate()` with equal consecutive stamps allowed (the
+/// trajectories of a reader under DuplicateStamps::kKeep).
+template <class Lazy = void>
+void validate_keeping_repeats(const Trajectory& traj) {
+  if (traj.t_s.size() != traj.poses.size()) {
+    throw invalid_argument("trajectory has " + std::to_string(traj.t_s.size()) + " stamps but " +
+                           std::to_string(traj.poses.size()) + " poses");
+  }
+  for (std::size_t k = 0; k < traj.poses.size(); ++k) {
+    if (!std::isfinite(traj.t_s[k]))
+      throw invalid_argument("trajectory stamp " + std::to_string(k) + " is not finite");
+    if (!traj.poses[k].matrix().allFinite())
+      throw invalid_argument("trajectory pose " + std::to_string(k) + " is not finite");
+    if (k > 0 && traj.t_s[k] < traj.t_s[k - 1])
+      throw invalid_argument("trajectory stamps decrease at index " + std::to_string(k));
+  }
+}
+
+}  // namespace detail::traj_io
+
 /// Reduces a reference and an estimate to their associated poses, as
 /// `evo_ape tum REF EST --t_max_diff D --t_offset O` does before computing.
 /// @param[in] ref reference trajectory (validated)
 /// @param[in] est estimated trajectory (validated)
 /// @param[in] max_diff_s largest accepted |time difference| (s)
 /// @param[in] offset_est_s time offset added to the estimate's stamps (s)
+/// @param[in] repeats how the trajectories were read: under
+///            DuplicateStamps::kKeep equal consecutive stamps are accepted
+///            (evo's behaviour: each repeated stamp of the shorter
+///            trajectory pairs with its nearest partner, of a run in the
+///            longer one the first pose is used); otherwise stamps must be
+///            strictly increasing
 /// @return both trajectories at the matched indices; stamps keep their own
 ///         time frames (the offset is not applied to them)
 /// @throws posefuse::invalid_argument when either trajectory fails
@@ -182,9 +211,15 @@ template <class Lazy = void>
 template <class Lazy = void>
 [[nodiscard]] AssociatedTrajectories associate(const Trajectory& ref, const Trajectory& est,
                                                double max_diff_s = 0.01,
-                                               double offset_est_s = 0.0) {
-  ref.validate();
-  est.validate();
+                                               double offset_est_s = 0.0,
+                                               DuplicateStamps repeats = DuplicateStamps::kError) {
+  if (repeats == DuplicateStamps::kKeep) {
+    detail::traj_io::validate_keeping_repeats(ref);
+    detail::traj_io::validate_keeping_repeats(est);
+  } else {
+    ref.validate();
+    est.validate();
+  }
   const Association a = associate(ref.t_s, est.t_s, max_diff_s, offset_est_s);
   return {select(ref, a.ref_ids), select(est, a.est_ids)};
 }

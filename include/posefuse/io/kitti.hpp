@@ -176,6 +176,7 @@ template <class Lazy = void>
   for (const std::size_t k : kept) traj.poses.push_back(rows.values[k]);
   if (report != nullptr) {
     report->duplicates_dropped += times_report.duplicates_dropped;
+    report->duplicates_kept += times_report.duplicates_kept;
     if (report->first_duplicate_line == 0) report->first_duplicate_line = times_report.first_duplicate_line;
   }
   return traj;

@@ -21,17 +21,23 @@ enum class DuplicateStamps {
   kError,  ///< refuse the file at the repeated line (file:line)
   kFirst,  ///< keep the first pose of a run of equal stamps, drop the others
   kLast,   ///< keep the last pose of a run of equal stamps, drop the others
+  /// keep every pose, as evo does: the trajectory then has equal stamps
+  /// (it fails `Trajectory::validate()`), and `associate(..., kKeep)` pairs
+  /// each repeated stamp of the shorter trajectory with its nearest partner
+  /// in the longer one (of a longer trajectory's run, the first pose is used)
+  kKeep,
 };
 
-/// Parses "error", "first" or "last".
+/// Parses "error", "first", "last" or "keep".
 /// @throws posefuse::invalid_argument for any other text
 template <class Lazy = void>
 [[nodiscard]] DuplicateStamps parse_duplicate_stamps(std::string_view name) {
   if (name == "error") return DuplicateStamps::kError;
   if (name == "first") return DuplicateStamps::kFirst;
   if (name == "last") return DuplicateStamps::kLast;
+  if (name == "keep") return DuplicateStamps::kKeep;
   throw invalid_argument("unknown duplicate-stamp policy '" + std::string(name) +
-                         "' (expected first, last or error)");
+                         "' (expected first, last, keep or error)");
 }
 
 /// The name `parse_duplicate_stamps` accepts for `policy`.
@@ -40,6 +46,7 @@ template <class Lazy = void>
     case DuplicateStamps::kError: return "error";
     case DuplicateStamps::kFirst: return "first";
     case DuplicateStamps::kLast: return "last";
+    case DuplicateStamps::kKeep: return "keep";
   }
   return "?";
 }
@@ -75,9 +82,11 @@ class repeated_stamp_error : public io_error {
   using io_error::io_error;
 };
 
-/// What a reader dropped under `ReadOptions::duplicates`.
+/// What a reader dropped (or, under DuplicateStamps::kKeep, kept) under
+/// `ReadOptions::duplicates`.
 struct ReadReport {
   std::size_t duplicates_dropped = 0;     ///< poses dropped for a repeated stamp
+  std::size_t duplicates_kept = 0;        ///< poses kept with a repeated stamp (kKeep)
   std::size_t first_duplicate_line = 0;   ///< 1-based line of the first repeat (0: none)
 };
 

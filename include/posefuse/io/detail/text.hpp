@@ -201,9 +201,10 @@ template <class Stamp>
   if (t > previous) return StampAction::kAppend;
   if (t == previous && policy != DuplicateStamps::kError) {
     if (report != nullptr) {
-      if (report->duplicates_dropped == 0) report->first_duplicate_line = line;
-      ++report->duplicates_dropped;
+      if (report->duplicates_dropped == 0 && report->duplicates_kept == 0) report->first_duplicate_line = line;
+      ++(policy == DuplicateStamps::kKeep ? report->duplicates_kept : report->duplicates_dropped);
     }
+    if (policy == DuplicateStamps::kKeep) return StampAction::kAppend;
     return policy == DuplicateStamps::kFirst ? StampAction::kSkip : StampAction::kReplaceLast;
   }
   throw_stamp_out_of_order(t, previous, previous_line, file, line, /*offer_policies=*/true);
