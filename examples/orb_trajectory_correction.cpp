@@ -3,13 +3,24 @@
 //
 // Scenario (seed 000, docs/reproductions.md): ORB-SLAM ran unchanged; its output
 // trajectory is filtered on the road plane and the planar RMSE against ground
-// truth is compared before and after (seed 000, Table 1). Three correctors:
+// truth is compared before and after (seed 000, Table 1). The correctors:
 //
 //   seed000   the seed's EKF exactly: x = [x, y], u = SLAM displacement,
 //             z = SLAM position, G = H = I, R (process) and Q (measurement).
 //             It returns its input (docs/reproductions.md), so its reduction is 0 %.
 //   cv        a constant-velocity EKF (own dynamics) on the SLAM positions.
 //   cv+rts    the same run smoothed offline (Rauch-Tung-Striebel).
+//   ctrv      a constant turn rate and velocity EKF [x, y, heading, v, yaw rate].
+//   ctrv+rts  the same run smoothed offline.
+//   control   (--control FILE) the seed's EKF with u from a second, independent
+//             trajectory, z still the SLAM position.
+//
+// --tune adds each method with its noise chosen by the innovation likelihood
+// of the estimate alone (apps/seed000_methods.hpp; the ground truth only
+// scores the result); --sweep prints the RMSE over a grid of noise levels
+// (apps/seed000_sweep.hpp) and --sweep-svg draws it. --groundtruth and
+// --estimate may be folders of same-named files: one row per sequence and
+// method, and a mean row.
 //
 // With no arguments it runs on a built-in synthetic drive (a KITTI-06-like
 // 1.2 km loop with heading drift, scale error and 0.35 m position jitter;
@@ -19,19 +30,19 @@
 //   synthetic    seed000             1.150           1.150     0.00 %   returns its input (docs/reproductions.md)
 //   synthetic    cv                  1.150           1.143     0.60 %   no real gain
 //   synthetic    cv+rts              1.150           1.049     8.72 %   helps
+//   synthetic    ctrv                1.150           1.071     6.84 %   helps
+//   synthetic    ctrv+rts            1.150           1.049     8.72 %   helps
 //
-// On KITTI 06 none of them reduces the error of ORB-SLAM2 stereo (0.874 m
-// before; seed000 0 %, cv -8 %, cv+rts -0.05 %): its error is drift.
-//
-// On KITTI 06 (kitti/06 of the data folder, docs/programs.md):
+// KITTI odometry sequence 06 (kitti/06 of the data folder, docs/programs.md),
+// figures in docs/reproductions.md:
 //
 //   orb_trajectory_correction --groundtruth groundtruth.txt --times times.txt
-//       --estimate orbslam2_stereo.txt --estimate cvo_vo.txt --plot kitti06.svg
+//       --estimate orbslam2_stereo.txt --control cvo_vo.txt --tune
 //
 // Options: see --help. Exit status 0 ok, 1 bad data (one line on stderr,
 // naming file:line where a file is at fault; also a filter step that was not
-// applied or a non-finite result), 2 bad usage. --out and --plot are written
-// only when everything was computed, each through a temporary file.
+// applied or a non-finite result), 2 bad usage. --out, --plot and --sweep-svg
+// are written only when everything was computed, each through a temporary file.
 
 #include <algorithm>
 #include <cmath>
@@ -47,30 +58,36 @@
 #include <apps/cli.hpp>
 #include <apps/json.hpp>
 #include <apps/output_file.hpp>
-#include <posefuse/sim/kitti_like_drive.hpp>
+#include <apps/seed000_methods.hpp>
+#include <apps/seed000_sweep.hpp>
 #include <apps/svg.hpp>
 #include <apps/trajectory_correction.hpp>
 #include <posefuse/eval/alignment.hpp>
 #include <posefuse/eval/metrics.hpp>
 #include <posefuse/io/association.hpp>
 #include <posefuse/io/formats.hpp>
+#include <posefuse/sim/kitti_like_drive.hpp>
 
 namespace {
 
 using namespace posefuse;
+namespace fs = std::filesystem;
+using apps::seed000::Family;
 
 struct Options {
-  std::optional<std::filesystem::path> groundtruth, times, out, plot;
-  std::vector<std::filesystem::path> estimates;
+  std::optional<fs::path> groundtruth, times, control, out, plot, sweep_svg;
+  std::vector<fs::path> estimates;
   Format format = Format::kKitti;
   Plane plane = Plane::kXZ;
   Eigen::Matrix2d R = Eigen::Matrix2d::Identity() * 0.01;
   Eigen::Matrix2d Q = Eigen::Matrix2d::Identity() * 0.25;
   double cv_q = 1.0;
+  double ctrv_q = 1.0;
   double max_time_diff = 0.01;
   Alignment alignment = Alignment::kNone;
   std::string method = "seed000";
-  bool json = false;
+  bool json = false, tune = false, sweep = false;
+  bool folders = false;  ///< --groundtruth / --estimate are folders of same-named files
 };
 
 /// "VAR" or "VAR,VAR": a diagonal covariance, each variance finite and > 0.
@@ -83,6 +100,9 @@ Eigen::Matrix2d parse_diag(std::string_view text) {
   return Eigen::Vector2d(a, b).asDiagonal();
 }
 
+const std::vector<std::string> kMethods{"seed000", "cv", "cv+rts", "ctrv", "ctrv+rts", "control"};
+const std::vector<std::string> kTunable{"cv", "cv+rts", "ctrv", "ctrv+rts", "control"};
+
 /// The options, or nothing when --help was printed.
 std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   Options o;
@@ -91,10 +111,17 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
                    "Filters SLAM trajectories on the road plane (seed 000) and compares the planar "
                    "RMSE\nagainst ground truth before and after. Without files it uses a built-in "
                    "synthetic drive.");
-  cli.path({.name = "--groundtruth", .value = "FILE", .help = "reference trajectory"},
+  cli.path({.name = "--groundtruth", .value = "FILE|DIR",
+            .help = "reference trajectory; a folder: one same-named file per sequence\n"
+                    "of the --estimate folder (00.txt, 05.txt, ...)"},
            o.groundtruth);
-  cli.paths({.name = "--estimate", .value = "FILE", .help = "trajectory to correct (repeat for several)"},
+  cli.paths({.name = "--estimate", .value = "FILE|DIR",
+             .help = "trajectory to correct (repeat for several), or one folder"},
             o.estimates);
+  cli.path({.name = "--control", .value = "FILE|DIR",
+            .help = "independent trajectory whose planar displacement is the control u\n"
+                    "of method 'control' (associated with the estimate by timestamp)"},
+           o.control);
   cli.custom({.name = "--format", .value = "kitti|tum", .help = "format of all files",
               .default_text = "kitti"},
              [&](std::string_view v) {
@@ -102,8 +129,8 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
                if (o.format == Format::kEuroc)
                  throw apps::usage_error("expected kitti or tum (EuRoC files: evaluate_trajectory)");
              });
-  cli.path({.name = "--times", .value = "FILE",
-            .help = "KITTI times.txt for the ground truth and KITTI estimates"},
+  cli.path({.name = "--times", .value = "FILE|DIR",
+            .help = "KITTI times.txt for all KITTI files (a folder: one per sequence)"},
            o.times);
   cli.custom({.name = "--plane", .value = "xz|xy|yz", .help = "road plane",
               .default_text = "xz: KITTI camera frame"},
@@ -117,18 +144,41 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   cli.real({.name = "--cv-q", .value = "Q", .help = "constant-velocity acceleration noise",
             .unit = "m^2/s^3"},
            o.cv_q, apps::Domain::kPositive);
+  cli.real({.name = "--ctrv-q", .value = "Q",
+            .help = "CTRV acceleration noise (yaw acceleration: Q / (10 m/s)^2)", .unit = "m^2/s^3"},
+           o.ctrv_q, apps::Domain::kPositive);
   cli.custom({.name = "--align", .value = "none|se3|sim3",
-              .help = "align each estimate to the ground truth first", .default_text = "none"},
+              .help = "align each estimate to the ground truth first (sim3: monocular);\n"
+                      "a control is aligned to its estimate the same way",
+              .default_text = "none"},
              [&](std::string_view v) { o.alignment = parse_alignment(v); });
-  cli.real({.name = "--max-time-diff", .value = "S", .help = "TUM timestamp association tolerance",
-            .unit = "s"},
+  cli.real({.name = "--max-time-diff", .value = "S",
+            .help = "TUM / control timestamp association tolerance", .unit = "s"},
            o.max_time_diff, apps::Domain::kNonNegative);
-  cli.custom({.name = "--method", .value = "seed000|cv|cv+rts",
-              .help = "corrector whose output --out writes", .default_text = "seed000"},
+  cli.flag({.name = "--tune",
+            .help = "add each method with noise chosen by its innovation likelihood\n"
+                    "on the estimate alone; with --estimate and no --groundtruth: only that"},
+           o.tune);
+  cli.flag({.name = "--sweep",
+            .help = "print the RMSE over a decade grid of process x measurement noise\n"
+                    "for each method (one estimate)"},
+           o.sweep);
+  cli.path({.name = "--sweep-svg", .value = "FILE.svg", .help = "the --sweep grid as heat maps"},
+           o.sweep_svg);
+  cli.custom({.name = "--method", .value = "NAME",
+              .help = "corrector whose output --out writes: seed000, cv, cv+rts, ctrv,\n"
+                      "ctrv+rts, control; with --tune also <method>/tuned (not seed000)",
+              .default_text = "seed000"},
              [&](std::string_view v) {
-               if (v != "seed000" && v != "cv" && v != "cv+rts")
-                 throw apps::usage_error("expected seed000, cv or cv+rts, got '" + std::string(v) + "'");
-               o.method = std::string(v);
+               std::string name(v);
+               const bool tuned = name.size() > 6 && name.ends_with("/tuned");
+               const std::string base = tuned ? name.substr(0, name.size() - 6) : name;
+               const auto& list = tuned ? kTunable : kMethods;
+               if (std::find(list.begin(), list.end(), base) == list.end())
+                 throw apps::usage_error("expected seed000, cv, cv+rts, ctrv, ctrv+rts, control "
+                                         "or one of those but seed000 followed by /tuned, got '" +
+                                         name + "'");
+               o.method = name;
              });
   cli.path({.name = "--out", .value = "PATH",
             .help = "write the corrected trajectory (input format); with several\n"
@@ -143,18 +193,48 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
                "fault),\n2 bad usage.");
   if (!cli.parse(cmd)) return std::nullopt;
 
-  if (o.groundtruth.has_value() != !o.estimates.empty())
+  const bool tune_only = o.tune && !o.groundtruth && !o.estimates.empty();
+  if (o.groundtruth.has_value() != !o.estimates.empty() && !tune_only)
     throw apps::usage_error("give --groundtruth and at least one --estimate, or neither (synthetic data)");
   if (o.times && o.format == Format::kTum)
     throw apps::usage_error("--times only applies to KITTI files");
+  if (o.control && o.estimates.empty())
+    throw apps::usage_error("--control needs --estimate (the built-in drive has no control)");
   if (cli.given("--method") && !o.out) throw apps::usage_error("--method chooses what --out writes; give --out");
+  if (o.method.ends_with("/tuned") && !o.tune) throw apps::usage_error("--method " + o.method + " needs --tune");
+  if (o.method.starts_with("control") && !o.control)
+    throw apps::usage_error("--method " + o.method + " needs --control");
+  if (o.sweep_svg && !o.sweep) throw apps::usage_error("--sweep-svg draws the --sweep grid; give --sweep");
+  if (tune_only && (o.out || o.plot || o.sweep || o.alignment != Alignment::kNone))
+    throw apps::usage_error("without --groundtruth, --tune only chooses noise: --out, --plot, --sweep "
+                            "and --align need --groundtruth");
+
+  // Folder mode: --groundtruth DIR and one --estimate DIR (or --estimate DIR alone with --tune).
+  const auto is_dir = [](const fs::path& p) { std::error_code ec; return fs::is_directory(p, ec); };
+  const bool est_dir = o.estimates.size() == 1 && is_dir(o.estimates.front());
+  o.folders = (o.groundtruth && is_dir(*o.groundtruth)) || est_dir;
+  if (o.folders) {
+    if (o.estimates.size() != 1 || !est_dir || (o.groundtruth && !is_dir(*o.groundtruth)))
+      throw apps::usage_error("folder mode needs --groundtruth DIR and one --estimate DIR of same-named files");
+    if (o.control && !is_dir(*o.control))
+      throw apps::usage_error("with folders, --control is a folder of same-named files too");
+    if (o.times && !is_dir(*o.times))
+      throw apps::usage_error("with folders, --times is a folder of same-named times files");
+    if (o.sweep) throw apps::usage_error("--sweep studies one estimate, not a folder");
+  } else {
+    if (o.control && is_dir(*o.control))
+      throw apps::usage_error("--control is a folder but --estimate is not");
+    if (o.sweep && o.estimates.size() > 1) throw apps::usage_error("--sweep studies one estimate; give one --estimate");
+  }
   {
-    std::vector<std::pair<std::string, std::filesystem::path>> outputs, inputs;
+    std::vector<std::pair<std::string, fs::path>> outputs, inputs;
     if (o.groundtruth) inputs.emplace_back("--groundtruth", *o.groundtruth);
     if (o.times) inputs.emplace_back("--times", *o.times);
+    if (o.control) inputs.emplace_back("--control", *o.control);
     for (const auto& e : o.estimates) inputs.emplace_back("--estimate", e);
-    if (o.out && o.estimates.size() <= 1) outputs.emplace_back("--out", *o.out);
+    if (o.out && o.estimates.size() <= 1 && !o.folders) outputs.emplace_back("--out", *o.out);
     if (o.plot) outputs.emplace_back("--plot", *o.plot);
+    if (o.sweep_svg) outputs.emplace_back("--sweep-svg", *o.sweep_svg);
     apps::refuse_output_over_input(outputs, inputs);
   }
   if (o.out && o.estimates.size() > 1) {
@@ -178,11 +258,14 @@ struct MethodResult {
 struct EstimateResult {
   std::string name;        ///< the estimate file's stem ("synthetic" for the built-in drive)
   std::string source;      ///< the estimate file, for error messages
+  bool has_truth = true;   ///< false in the tune-only mode
   Trajectory groundtruth;  ///< associated with the estimate
   Trajectory estimate;     ///< aligned as requested
   std::vector<Eigen::Vector2d> truth_xy, raw_xy;
+  apps::seed000::PlanarInput input;  ///< what the filters see
   double rmse_before = 0;
   std::vector<MethodResult> methods;
+  std::vector<apps::seed000::TunedNoise> tuned;
 };
 
 /// Throws a data error when `v` is not finite: no inf or nan reaches the output.
@@ -196,74 +279,114 @@ void require_finite(const std::vector<Eigen::Vector2d>& points, const std::strin
       throw apps::data_error(what + " is not finite at frame " + std::to_string(k));
 }
 
-/// A filter step that was not applied leaves a stale state: reported, not ignored.
-void require_applied(const CorrectedPoint& c, const std::string& source, const char* method,
-                     std::size_t k) {
-  if (c.status != FilterStatus::kApplied)
-    throw apps::data_error(source + ": frame " + std::to_string(k) + " (t = " + apps::shortest(c.t) +
-                           " s): the " + method + " filter step was not applied (" +
-                           to_string(c.status) + ")");
+/// The frames of `est` that also have a control pose (by timestamp), with
+/// `gt` (same frames as `est`, may be empty) reduced alike.
+/// @throws data_error naming the control file when fewer than 2 frames match
+Trajectory associate_control(const std::string& est_source, Trajectory& est, Trajectory* gt,
+                             const Trajectory& control, const std::string& control_source,
+                             double max_time_diff) {
+  Association a;
+  try {
+    a = associate(std::span<const double>(est.t_s), std::span<const double>(control.t_s), max_time_diff);
+  } catch (const posefuse::invalid_argument& e) {
+    throw apps::data_error(control_source + ": " + e.what() + " (against " + est_source + ")");
+  }
+  // Keep pairs where both indices advance (the nearest-stamp rule can repeat one).
+  std::vector<std::size_t> ei, ci;
+  for (std::size_t k = 0; k < a.size(); ++k)
+    if (ei.empty() || (a.ref_ids[k] > ei.back() && a.est_ids[k] > ci.back()))
+      ei.push_back(a.ref_ids[k]), ci.push_back(a.est_ids[k]);
+  if (ei.size() < 2)
+    throw apps::data_error(control_source + ": only " + std::to_string(ei.size()) +
+                           " frame(s) associate with " + est_source + " within --max-time-diff " +
+                           apps::shortest(max_time_diff) + " s; the control needs at least 2");
+  est = select(est, ei);
+  if (gt != nullptr) *gt = select(*gt, ei);
+  return select(control, ci);
 }
 
-EstimateResult correct(std::string name, std::string source, const Trajectory& gt_full,
-                       const Trajectory& est_full, const Options& o) {
+EstimateResult correct(std::string name, std::string source, const Trajectory* gt_full,
+                       const Trajectory& est_full, const Trajectory* control_full,
+                       const std::string& control_source, const Options& o) {
   EstimateResult r;
   r.name = std::move(name);
   r.source = std::move(source);
-  if (o.format == Format::kTum) {
-    const AssociatedTrajectories a = associate(gt_full, est_full, o.max_time_diff);
+  r.has_truth = gt_full != nullptr;
+  if (!r.has_truth) {
+    r.estimate = est_full;
+  } else if (o.format == Format::kTum) {
+    const AssociatedTrajectories a = associate(*gt_full, est_full, o.max_time_diff);
     r.groundtruth = a.ref;
     r.estimate = a.est;
   } else {
-    if (gt_full.size() != est_full.size())
+    if (gt_full->size() != est_full.size())
       throw apps::data_error(r.source + " has " + std::to_string(est_full.size()) +
-                             " poses but the ground truth has " + std::to_string(gt_full.size()));
-    r.groundtruth = gt_full;
+                             " poses but the ground truth has " + std::to_string(gt_full->size()));
+    r.groundtruth = *gt_full;
     r.estimate = est_full;
   }
   if (r.estimate.size() == 0) throw apps::data_error(r.source + " has no poses");
-  r.estimate = align_trajectory(r.estimate, r.groundtruth, o.alignment).trajectory;
-  r.truth_xy = project_to_plane(r.groundtruth, o.plane);
+  Trajectory control;
+  if (control_full != nullptr)
+    control = associate_control(r.source, r.estimate, r.has_truth ? &r.groundtruth : nullptr,
+                                *control_full, control_source, o.max_time_diff);
+  if (r.has_truth) r.estimate = align_trajectory(r.estimate, r.groundtruth, o.alignment).trajectory;
+  if (control_full != nullptr && o.alignment != Alignment::kNone)
+    control = align_trajectory(control, r.estimate, o.alignment).trajectory;
   r.raw_xy = project_to_plane(r.estimate, o.plane);
-  require_finite(r.truth_xy, r.source + ": the ground truth on the road plane");
   require_finite(r.raw_xy, r.source + ": the estimate on the road plane" +
                                std::string(o.alignment == Alignment::kNone ? "" : " after alignment"));
+  r.input.source = r.source;
+  r.input.t = r.estimate.t_s;
+  r.input.z = r.raw_xy;
+  if (control_full != nullptr) {
+    r.input.control = project_to_plane(control, o.plane);
+    require_finite(r.input.control, control_source + ": the control on the road plane");
+  }
+
+  namespace s0 = apps::seed000;
+  std::vector<MethodResult> runs;
+  const auto add = [&](std::string method, s0::MethodRun run) {
+    runs.push_back({std::move(method), std::move(run.points), std::move(run.variance), 0});
+  };
+  const double sigma2 = 0.5 * o.Q.trace();
+  if (r.has_truth) {
+    add("seed000", s0::run_displacement(r.input, r.input.z, o.R, o.Q, "seed000"));
+    std::optional<s0::MethodRun> smoothed;
+    add("cv", s0::run_cv(r.input, o.cv_q, sigma2, &smoothed));
+    add("cv+rts", std::move(*smoothed));
+    add("ctrv", s0::run_ctrv(r.input, o.ctrv_q, sigma2, &smoothed));
+    add("ctrv+rts", std::move(*smoothed));
+    if (control_full != nullptr)
+      add("control", s0::run_displacement(r.input, r.input.control, o.R, o.Q, "control"));
+  }
+  if (o.tune) {
+    for (Family f : {Family::kCv, Family::kCtrv, Family::kControl}) {
+      if (f == Family::kControl && control_full == nullptr) continue;
+      const s0::TunedNoise t = s0::tune_family(r.input, f);
+      r.tuned.push_back(t);
+      if (!r.has_truth) continue;
+      std::optional<s0::MethodRun> smoothed;
+      const std::string base = s0::family_name(f);
+      add(base + "/tuned", s0::run_family(r.input, f, t.result.process, t.result.measurement,
+                                          f == Family::kControl ? nullptr : &smoothed));
+      if (smoothed) add(base + "+rts/tuned", std::move(*smoothed));
+    }
+  }
+  if (!r.has_truth) return r;
+
+  r.truth_xy = project_to_plane(r.groundtruth, o.plane);
+  require_finite(r.truth_xy, r.source + ": the ground truth on the road plane");
   r.rmse_before = rmse_2d(r.truth_xy, r.raw_xy);
   require_finite(r.rmse_before, r.source + ": the planar RMSE before correction");
-
-  MethodResult seed{"seed000", {}, {}, 0};
-  auto seed_pipeline = make_seed000_corrector(o.plane, o.R, o.Q, Eigen::Matrix2d::Identity());
-  const double sigma = std::sqrt(0.5 * o.Q.trace());
-  auto cv_pipeline = make_constant_velocity_corrector(o.plane, o.cv_q, sigma);
-  MethodResult cv{"cv", {}, {}, 0};
-  for (std::size_t k = 0; k < r.estimate.size(); ++k) {
-    const StampedPose in{r.estimate.t_s[k], r.estimate.poses[k]};
-    const CorrectedPoint s = seed_pipeline(in);
-    require_applied(s, r.source, "seed000", k);
-    seed.points.push_back(s.p);
-    seed.variance.push_back(0.5 * s.P.trace());
-    const CorrectedPoint c = cv_pipeline(in);
-    require_applied(c, r.source, "cv", k);
-    cv.points.push_back(c.p);
-    cv.variance.push_back(0.5 * c.P.trace());
-  }
-  MethodResult rts{"cv+rts", {}, {}, 0};
-  try {
-    for (const auto& b : rts_smooth(cv_pipeline.stage<1>().history())) {
-      rts.points.push_back(b.mean.head<2>());
-      rts.variance.push_back(0.5 * b.cov.topLeftCorner<2, 2>().trace());
-    }
-  } catch (const posefuse::invalid_argument& e) {
-    throw apps::data_error(r.source + ": cv+rts: " + e.what());
-  }
-  for (MethodResult* m : {&seed, &cv, &rts}) {
-    const std::string what = r.source + ": " + m->name;
-    require_finite(m->points, what + " corrected position");
-    for (std::size_t k = 0; k < m->variance.size(); ++k)
-      require_finite(m->variance[k], what + " variance at frame " + std::to_string(k));
-    m->rmse = rmse_2d(r.truth_xy, m->points);
-    require_finite(m->rmse, what + " RMSE after correction");
-    r.methods.push_back(std::move(*m));
+  for (MethodResult& m : runs) {
+    const std::string what = r.source + ": " + m.name;
+    require_finite(m.points, what + " corrected position");
+    for (std::size_t k = 0; k < m.variance.size(); ++k)
+      require_finite(m.variance[k], what + " variance at frame " + std::to_string(k));
+    m.rmse = rmse_2d(r.truth_xy, m.points);
+    require_finite(m.rmse, what + " RMSE after correction");
+    r.methods.push_back(std::move(m));
   }
   return r;
 }
@@ -276,13 +399,47 @@ std::optional<double> reduction_percent(double before, double after) {
   return std::isfinite(red) ? std::optional<double>(red) : std::nullopt;
 }
 
+/// "helps" only for a reduction of at least 1 % (so never when after > before).
 std::string verdict(const std::string& method, double before, double after) {
   const std::optional<double> red = reduction_percent(before, after);
   if (!red) return "worse than raw";
   if (method == "seed000" && std::abs(*red) < 1e-6) return "returns its input (docs/reproductions.md)";
-  if (*red >= 1.0) return "helps";
+  if (*red >= 1.0 && after < before) return "helps";
   if (*red > -1.0) return "no real gain";
   return "worse than raw";
+}
+
+/// One row of the folder table's mean: the means over the sequences, and
+/// how many sequences the method made worse.
+struct MeanRow {
+  std::string method;
+  double before = 0, after = 0;
+  std::size_t worse = 0, sequences = 0;
+};
+
+std::vector<MeanRow> mean_rows(const std::vector<EstimateResult>& results) {
+  std::vector<MeanRow> rows;
+  for (const auto& m : results.front().methods) rows.push_back({m.name, 0, 0, 0, 0});
+  for (MeanRow& row : rows) {
+    for (const auto& r : results)
+      for (const auto& m : r.methods)
+        if (m.name == row.method) {
+          row.before += r.rmse_before;
+          row.after += m.rmse;
+          row.worse += m.rmse > r.rmse_before ? 1 : 0;
+          ++row.sequences;
+        }
+    row.before /= static_cast<double>(row.sequences);
+    row.after /= static_cast<double>(row.sequences);
+  }
+  return rows;
+}
+
+/// The mean row's verdict: "helps" only when no sequence got worse.
+std::string mean_verdict(const MeanRow& row) {
+  const std::string v = verdict(row.method, row.before, row.after);
+  if (row.worse == 0 || v == "worse than raw") return v;
+  return "worse on " + std::to_string(row.worse) + " of " + std::to_string(row.sequences) + " sequences";
 }
 
 /// Seed 000 Fig. 8: the first frame at which |d(variance)/dframe| < 0.01.
@@ -335,70 +492,197 @@ std::string plot_svg(const EstimateResult& r, Plane plane) {
   return doc.str();
 }
 
+/// The tuned noise levels, one line per estimate and method.
+void print_tuned(const std::vector<EstimateResult>& results) {
+  std::printf("\nNoise chosen by the innovation likelihood of each estimate alone (no ground truth):\n\n");
+  for (const auto& r : results)
+    for (const auto& t : r.tuned) {
+      const auto [pu, mu] = apps::seed000::family_units(t.family);
+      const auto& x = t.result;
+      std::printf("%-22s %-8s %s = %-9.4g %s = %-9.4g log-likelihood %.2f%s\n", r.name.c_str(),
+                  apps::seed000::family_name(t.family), pu, x.process, mu, x.measurement,
+                  x.log_likelihood,
+                  x.process_at_bound || x.measurement_at_bound ? " (at the edge of the range searched)" : "");
+    }
+  std::printf("\nX/tuned and X+rts/tuned share the X filter's values. seed000 is not tuned: its "
+              "innovations are zero\n(it returns its input), so its likelihood only grows as R and Q "
+              "shrink.\n");
+}
+
 void print_json(const Options& o, const std::vector<EstimateResult>& results) {
-  const auto [steady_frame, steady_value] = steady_state(results.front().methods[0].variance);
   using Layout = apps::JsonWriter::Layout;
   apps::JsonWriter j(std::cout);
   j.begin_object();
   j.member("plane", to_string(o.plane)).member("alignment", to_string(o.alignment));
+  const bool truth = results.front().has_truth;
   j.key("estimates").begin_array(Layout::kBlock);
   for (const auto& r : results) {
     j.begin_object();
-    j.member("name", r.name).member("frames", r.estimate.size()).member("rmse_before", r.rmse_before);
-    j.key("methods").begin_array(Layout::kBlock);
-    for (const auto& m : r.methods) {
-      j.begin_object(Layout::kInline).member("method", m.name).member("rmse_after", m.rmse);
-      const std::optional<double> red = reduction_percent(r.rmse_before, m.rmse);
+    j.member("name", r.name).member("frames", r.estimate.size());
+    if (truth) {
+      j.member("rmse_before", r.rmse_before);
+      j.key("methods").begin_array(Layout::kBlock);
+      for (const auto& m : r.methods) {
+        j.begin_object(Layout::kInline).member("method", m.name).member("rmse_after", m.rmse);
+        const std::optional<double> red = reduction_percent(r.rmse_before, m.rmse);
+        j.key("reduction_percent");
+        if (red) j.value(*red);
+        else j.null();
+        j.member("verdict", verdict(m.name, r.rmse_before, m.rmse)).end_object();
+      }
+      j.end_array();
+    }
+    if (o.tune) {
+      j.key("tuned").begin_array(Layout::kBlock);
+      for (const auto& t : r.tuned) {
+        const auto [pu, mu] = apps::seed000::family_units(t.family);
+        j.begin_object(Layout::kInline)
+            .member("method", apps::seed000::family_name(t.family))
+            .member("process", t.result.process)
+            .member("process_unit", pu)
+            .member("measurement", t.result.measurement)
+            .member("measurement_unit", mu)
+            .member("log_likelihood", t.result.log_likelihood)
+            .member("at_bound", t.result.process_at_bound || t.result.measurement_at_bound)
+            .end_object();
+      }
+      j.end_array();
+    }
+    j.end_object();
+  }
+  j.end_array();
+  if (truth) {
+    // One row per sequence and method, and (folders) the mean rows.
+    const auto row = [&](const std::string& sequence, const std::string& method, double before,
+                         double after, const std::string& v) {
+      j.begin_object(Layout::kInline).member("sequence", sequence).member("method", method);
+      j.member("rmse_before", before).member("rmse_after", after);
+      const std::optional<double> red = reduction_percent(before, after);
       j.key("reduction_percent");
       if (red) j.value(*red);
       else j.null();
-      j.member("verdict", verdict(m.name, r.rmse_before, m.rmse)).end_object();
+      j.member("verdict", v).end_object();
+    };
+    j.key("rows").begin_array(Layout::kBlock);
+    for (const auto& r : results)
+      for (const auto& m : r.methods)
+        row(r.name, m.name, r.rmse_before, m.rmse, verdict(m.name, r.rmse_before, m.rmse));
+    j.end_array();
+    if (o.folders) {
+      j.key("mean").begin_array(Layout::kBlock);
+      for (const MeanRow& m : mean_rows(results))
+        row("mean", m.method, m.before, m.after, mean_verdict(m));
+      j.end_array();
     }
-    j.end_array().end_object();
+    const auto [steady_frame, steady_value] = steady_state(results.front().methods[0].variance);
+    j.key("seed000_covariance").begin_object(Layout::kInline);
+    j.member("initial", results.front().methods[0].variance.front())
+        .member("steady", steady_value)
+        .member("steady_frame", steady_frame);
+    j.end_object();
   }
-  j.end_array();
-  j.key("seed000_covariance").begin_object(Layout::kInline);
-  j.member("initial", results.front().methods[0].variance.front())
-      .member("steady", steady_value)
-      .member("steady_frame", steady_frame);
-  j.end_object().end_object().finish();
+  j.end_object().finish();
 }
 
 void print_table(const Options& o, const std::vector<EstimateResult>& results) {
+  if (!results.front().has_truth) {
+    print_tuned(results);
+    return;
+  }
+  std::size_t width = 8;
+  for (const auto& m : results.front().methods) width = std::max(width, m.name.size());
+  const int w = static_cast<int>(width);
   const auto [steady_frame, steady_value] = steady_state(results.front().methods[0].variance);
   std::printf("Planar RMSE against ground truth (seed 000, Table 1), plane %s, alignment %s\n\n",
               std::string(to_string(o.plane)).c_str(), std::string(to_string(o.alignment)).c_str());
-  std::printf("%-22s %-8s %16s %15s %10s   %s\n", "estimate", "method", "RMSE before [m]",
-              "RMSE after [m]", "reduction", "verdict");
-  for (const auto& r : results) {
-    for (const auto& m : r.methods) {
-      const std::optional<double> red = reduction_percent(r.rmse_before, m.rmse);
-      std::printf("%-22s %-8s %16.3f %15.3f ", r.name.c_str(), m.name.c_str(), r.rmse_before, m.rmse);
-      if (red) std::printf("%8.2f %%", *red);
-      else std::printf("%10s", "n/a");
-      std::printf("   %s\n", verdict(m.name, r.rmse_before, m.rmse).c_str());
-    }
-  }
+  std::printf("%-22s %-*s %16s %15s %10s   %s\n", o.folders ? "sequence" : "estimate", w, "method",
+              "RMSE before [m]", "RMSE after [m]", "reduction", "verdict");
+  const auto line = [&](const std::string& name, const std::string& method, double before,
+                        double after, const std::string& v) {
+    const std::optional<double> red = reduction_percent(before, after);
+    std::printf("%-22s %-*s %16.3f %15.3f ", name.c_str(), w, method.c_str(), before, after);
+    if (red) std::printf("%8.2f %%", *red);
+    else std::printf("%10s", "n/a");
+    std::printf("   %s\n", v.c_str());
+  };
+  for (const auto& r : results)
+    for (const auto& m : r.methods) line(r.name, m.name, r.rmse_before, m.rmse, verdict(m.name, r.rmse_before, m.rmse));
+  if (o.folders)
+    for (const MeanRow& m : mean_rows(results)) line("mean", m.method, m.before, m.after, mean_verdict(m));
   std::printf("\nseed000 position variance trace(P)/2: %.4f m^2 at the first frame, steady "
               "(|dP/dframe| < 0.01) at %.4f m^2 from frame %zu.\n",
               results.front().methods[0].variance.front(), steady_value, steady_frame);
   std::printf("seed000 returns its input whatever R and Q (u = z_t - z_{t-1} cancels the gain; "
               "docs/reproductions.md).\n");
+  if (o.tune) print_tuned(results);
+}
+
+/// One sequence's files.
+struct SequenceFiles {
+  std::string name;
+  fs::path estimate;
+  std::optional<fs::path> groundtruth, control, times;
+};
+
+/// The sequences to run: the --estimate files, or the files of the
+/// --estimate folder with their same-named ground truth (and control, times).
+std::vector<SequenceFiles> sequences(const Options& o) {
+  std::vector<SequenceFiles> out;
+  if (!o.folders) {
+    for (const auto& e : o.estimates)
+      out.push_back({e.stem().string(), e, o.groundtruth, o.control, o.times});
+    return out;
+  }
+  std::vector<fs::path> files;
+  for (const auto& entry : fs::directory_iterator(o.estimates.front()))
+    if (entry.is_regular_file() && entry.path().filename().string().front() != '.')
+      files.push_back(entry.path());
+  std::sort(files.begin(), files.end());
+  if (files.empty()) throw apps::data_error(o.estimates.front().string() + ": no estimate files in the folder");
+  const auto partner = [&](const std::optional<fs::path>& dir, const fs::path& f,
+                           const char* what) -> std::optional<fs::path> {
+    if (!dir) return std::nullopt;
+    const fs::path p = *dir / f.filename();
+    if (!fs::is_regular_file(p))
+      throw apps::data_error(p.string() + ": no " + what + " for " + f.string() +
+                             " (folders pair files by name)");
+    return p;
+  };
+  for (const auto& f : files)
+    out.push_back({f.stem().string(), f, partner(o.groundtruth, f, "ground truth"),
+                   partner(o.control, f, "control"), partner(o.times, f, "times file")});
+  return out;
 }
 
 int run(const Options& o) {
   // 1. Compute everything; any failure stops here, before an output exists.
   std::vector<EstimateResult> results;
-  if (!o.groundtruth) {
+  if (o.estimates.empty()) {
     const sim::SyntheticDrive drive = sim::make_kitti_like_drive();
-    results.push_back(correct("synthetic", "built-in synthetic drive", drive.groundtruth,
-                              drive.estimate, o));
+    results.push_back(correct("synthetic", "built-in synthetic drive", &drive.groundtruth,
+                              drive.estimate, nullptr, {}, o));
   } else {
-    const auto times = o.format == Format::kKitti ? o.times : std::nullopt;
-    const Trajectory gt = read_trajectory(*o.groundtruth, o.format, times);
-    for (const auto& e : o.estimates)
-      results.push_back(
-          correct(e.stem().string(), e.string(), gt, read_trajectory(e, o.format, times), o));
+    for (const SequenceFiles& s : sequences(o)) {
+      const auto times = o.format == Format::kKitti ? s.times : std::nullopt;
+      std::optional<Trajectory> gt, control;
+      if (s.groundtruth) gt = read_trajectory(*s.groundtruth, o.format, times);
+      if (s.control) control = read_trajectory(*s.control, o.format, times);
+      results.push_back(correct(s.name, s.estimate.string(), gt ? &*gt : nullptr,
+                                read_trajectory(s.estimate, o.format, times),
+                                control ? &*control : nullptr,
+                                s.control ? s.control->string() : std::string(), o));
+    }
+  }
+  std::vector<apps::seed000::SweepTable> sweep;
+  if (o.sweep) {
+    const EstimateResult& r = results.front();
+    std::vector<std::pair<Family, std::pair<double, double>>> families{
+        {Family::kSeed, {0.5 * o.R.trace(), 0.5 * o.Q.trace()}},
+        {Family::kCv, {o.cv_q, 0.5 * o.Q.trace()}},
+        {Family::kCtrv, {o.ctrv_q, 0.5 * o.Q.trace()}}};
+    if (!r.input.control.empty())
+      families.push_back({Family::kControl, {0.5 * o.R.trace(), 0.5 * o.Q.trace()}});
+    sweep = apps::seed000::sweep(r.input, r.truth_xy, families);
   }
 
   // 2. The output files, in memory (the SVG refuses non-finite numbers).
@@ -409,24 +693,32 @@ int run(const Options& o) {
     for (const auto& r : results) {
       const auto m = std::find_if(r.methods.begin(), r.methods.end(),
                                   [&](const MethodResult& x) { return x.name == o.method; });
-      corrected.emplace_back(r.name + "_" + o.method + ext, corrected_trajectory(r, *m, o.plane));
+      const std::string file = r.name + "_" + std::string(o.method.substr(0, o.method.find('/'))) +
+                               (o.method.ends_with("/tuned") ? "_tuned" : "") + ext;
+      corrected.emplace_back(file, corrected_trajectory(r, *m, o.plane));
     }
-    if (results.size() == 1) {
+    if (results.size() == 1 && !o.folders) {
       files.add_with(*o.out, [t = std::move(corrected.front().second), f = o.format](
-                                 const std::filesystem::path& p) { write_trajectory(p, t, f); });
+                                 const fs::path& p) { write_trajectory(p, t, f); });
     } else {
-      files.add_folder(*o.out, [c = std::move(corrected), f = o.format](
-                                   const std::filesystem::path& dir) {
+      files.add_folder(*o.out, [c = std::move(corrected), f = o.format](const fs::path& dir) {
         for (const auto& [name, t] : c) write_trajectory(dir / name, t, f);
       });
     }
   }
   if (o.plot) files.add(*o.plot, plot_svg(results.front(), o.plane));
+  if (o.sweep_svg)
+    files.add(*o.sweep_svg,
+              apps::seed000::sweep_svg(sweep, results.front().name, results.front().rmse_before));
 
   // 3. Write the files (all or none), then the report.
   files.commit();
-  if (o.json) print_json(o, results);
-  else print_table(o, results);
+  if (o.json) {
+    print_json(o, results);
+  } else {
+    print_table(o, results);
+    if (o.sweep) apps::seed000::print_sweep(sweep, results.front().name, results.front().rmse_before);
+  }
   return 0;
 }
 

@@ -23,6 +23,7 @@
 #include <optional>
 #include <posefuse/core/pipeline.hpp>
 #include <posefuse/filters/ekf.hpp>
+#include <posefuse/filters/noise_tuning.hpp>
 #include <posefuse/filters/rts_smoother.hpp>
 #include <posefuse/core/plane.hpp>
 #include <posefuse/models/constant_velocity.hpp>
@@ -63,6 +64,10 @@ struct CorrectedPoint {
   Eigen::Matrix2d P = Eigen::Matrix2d::Identity();
   FilterStatus status = FilterStatus::kApplied;
   double nis = 0;
+  /// The frame's innovation log-likelihood term
+  /// \f$ -\tfrac12 (\nu^\top S^{-1} \nu + \log\det S) \f$ (filters/noise_tuning.hpp);
+  /// 0 when no update was tried (the first frame, a prediction not applied).
+  double log_likelihood = 0;
 };
 
 /// Stage: pose -> road-plane position (drops height, roll and pitch).
@@ -128,6 +133,7 @@ class DisplacementEkf {
         const auto r = ekf_.update<0>(in.z);
         out.status = r.status;
         out.nis = r.nis;
+        out.log_likelihood = innovation_log_likelihood(r);
       }
     }
     out.p = ekf_.state();
@@ -203,6 +209,7 @@ class ConstantVelocityFilter {
         const auto r = ekf_.update<0>(in.p);
         out.status = r.status;
         out.nis = r.nis;
+        out.log_likelihood = innovation_log_likelihood(r);
       } else {
         // Not applied: the belief is still the previous one, at the previous
         // time. Record that (F = I, predicted = filtered = unchanged) rather

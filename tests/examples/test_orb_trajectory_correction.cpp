@@ -53,14 +53,22 @@ TEST_CASE("orb_trajectory_correction: built-in drive reproduces the seed-000 ide
   CHECK(e["name"].string() == "synthetic");
   CHECK(e["frames"].number() > 1000);
   const auto& methods = e["methods"].array();
-  REQUIRE(methods.size() == 3);
+  REQUIRE(methods.size() == 5);
   CHECK(methods[0]["method"].string() == "seed000");
   CHECK(methods[1]["method"].string() == "cv");
   CHECK(methods[2]["method"].string() == "cv+rts");
+  CHECK(methods[3]["method"].string() == "ctrv");
+  CHECK(methods[4]["method"].string() == "ctrv+rts");
   CHECK(methods[0]["reduction_percent"].number() == Approx(0.0).margin(1e-9));
   CHECK(methods[0]["rmse_after"].number() == Approx(e["rmse_before"].number()).epsilon(1e-12));
   CHECK(methods[0]["verdict"].string() == "returns its input (docs/reproductions.md)");
   CHECK(methods[2]["reduction_percent"].number() > 3.0);  // smoothing removes the jitter
+  CHECK(methods[4]["reduction_percent"].number() > 3.0);
+  // One flat row per estimate and method, as in folder mode.
+  REQUIRE(j["rows"].array().size() == 5);
+  CHECK(j["rows"][4]["sequence"].string() == "synthetic");
+  CHECK(j["rows"][4]["method"].string() == "ctrv+rts");
+  CHECK(j["rows"][4]["rmse_after"].number() == methods[4]["rmse_after"].number());
   CHECK(j["seed000_covariance"]["initial"].number() == 1.0);
   CHECK(j["seed000_covariance"]["steady_frame"].number() >= 1);
 
@@ -76,12 +84,12 @@ TEST_CASE("orb_trajectory_correction: docs/reproductions.md's table and the exam
   posefuse::test::TempDir dir("orb");
   const auto r = posefuse::test::run(exe, "", dir);
   REQUIRE(r.status == 0);
-  // The three synthetic rows, with the estimate column narrowed as in the comment.
+  // The five synthetic rows, with the estimate column narrowed as in the comment.
   std::vector<std::string> rows;
   std::istringstream in(r.out);
   for (std::string line; std::getline(in, line);)
     if (line.rfind("synthetic ", 0) == 0) rows.push_back(line);
-  REQUIRE(rows.size() == 3);
+  REQUIRE(rows.size() == 5);
   const std::filesystem::path root =
       std::filesystem::path(__FILE__).parent_path().parent_path().parent_path();
   const std::string page = posefuse::test::slurp(root / "docs" / "reproductions.md");
@@ -115,6 +123,10 @@ TEST_CASE("orb_trajectory_correction: writes the corrected trajectory; usage err
         files + " --plane ab", files + " --R -1", files + " --R 1,abc", files + " --Q 0",
         files + " --bogus 3", files + " --cv-q 1e400", files + " --cv-q inf", files + " --cv-q",
         files + " --method kalman", files + " --format tum --times '" + gt.string() + "'",
+        files + " --method seed000/tuned --tune --out x.txt", files + " --method cv/tuned --out x.txt",
+        files + " --method control --out x.txt", files + " --sweep-svg s.svg", files + " --ctrv-q 0",
+        "--control '" + est.string() + "'",  // no estimate to drive
+        "--tune --estimate '" + est.string() + "' --plot p.svg",  // tune-only mode writes nothing
         files + " --max-time-diff -1", files + " stray", files + " --json --json",
         "--groundtruth '" + gt.string() + "' --estimate '" + est.string() + "' --estimate '" +
             est.string() + "' --out '" + dir.path().string() + "/o'"}) {  // two estimates named est
@@ -129,9 +141,10 @@ TEST_CASE("orb_trajectory_correction: writes the corrected trajectory; usage err
   const auto help = posefuse::test::run(exe, "--help", dir);
   CHECK(help.status == 0);
   CHECK(help.err.empty());
-  for (const char* flag : {"--groundtruth", "--estimate", "--format", "--times", "--plane", "--R",
-                           "--Q", "--cv-q", "--align", "--max-time-diff", "--method", "--out",
-                           "--plot", "--json", "--help"})
+  for (const char* flag : {"--groundtruth", "--estimate", "--control", "--format", "--times",
+                           "--plane", "--R", "--Q", "--cv-q", "--ctrv-q", "--align",
+                           "--max-time-diff", "--tune", "--sweep", "--sweep-svg", "--method",
+                           "--out", "--plot", "--json", "--help"})
     CHECK(help.out.find(std::string("  ") + flag + " ") != std::string::npos);
 }
 
