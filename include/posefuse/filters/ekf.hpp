@@ -280,7 +280,7 @@ class BasicEkf {
   ///         kNotPositiveDefinite, kNotInitialised) and innovation statistics;
   ///         the filter is unchanged unless kApplied
   template <class H, class Gate = Scalar>
-  [[nodiscard]] auto update_with(const H& sensor, const typename detail::measurement_of<H>::type& z,
+  [[nodiscard, gnu::always_inline]] auto update_with(const H& sensor, const typename detail::measurement_of<H>::type& z,
                                  const Gate& gate = std::numeric_limits<Scalar>::infinity()) {
     constexpr bool is_model = check_measurement_model<H>();
     static_assert(is_model,
