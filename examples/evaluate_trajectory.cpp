@@ -482,7 +482,7 @@ int run_read(const Options& given, apps::SpooledInputs& spool) {
   progress.clear();
   apps::OutputFiles outputs;
   if (o.save_results) outputs.add(*o.save_results, apps::results_json(o, evaluation, warnings));
-  if (o.plot) outputs.add(*o.plot, plot_svg(o, result, evaluation.ref_used, evaluation.est_used));
+  if (o.plot) outputs.add(*o.plot, plot_svg(o, result, evaluation.ref_used(), evaluation.est_used()));
   outputs.commit();
   if (o.json) {
     print_json(o, result, nees);

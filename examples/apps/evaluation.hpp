@@ -63,10 +63,20 @@ struct LoadedTrajectory {
 };
 
 /// The associated poses, the metric and (APE of an estimate with covariance) NEES.
+/// Compared frame by frame without thinning, the poses used are the
+/// inputs' own (not copied): the trajectories given to `evaluate` must then
+/// outlive the Evaluation.
 struct Evaluation {
-  posefuse::Trajectory ref_used, est_used;  ///< associated (and thinned) poses, est not aligned
   posefuse::MetricResult result;
   std::optional<posefuse::NeesResult> nees;
+  /// The associated (and thinned) reference poses.
+  [[nodiscard]] const posefuse::Trajectory& ref_used() const { return ref_input ? *ref_input : ref_kept; }
+  /// The associated (and thinned) estimate poses, not aligned.
+  [[nodiscard]] const posefuse::Trajectory& est_used() const { return est_input ? *est_input : est_kept; }
+
+  const posefuse::Trajectory* ref_input = nullptr;  ///< the input itself, when used as is
+  const posefuse::Trajectory* est_input = nullptr;
+  posefuse::Trajectory ref_kept, est_kept;  ///< otherwise the poses used
 };
 
 /// The --pose-relation spelling ("trans" for the translation part).
@@ -159,8 +169,13 @@ inline Evaluation evaluate(const EvaluationSetup& o, const LoadedTrajectory& ref
                        std::to_string(est.size()) +
                        "; KITTI files without --times are compared frame by frame");
     }
-    out.ref_used = *ref;
-    out.est_used = est;
+    if (thinning) {
+      out.ref_kept = std::move(ref_kept);
+      out.est_kept = std::move(est_kept);
+    } else {
+      out.ref_input = &ref_file;
+      out.est_input = &est_file;
+    }
   } else {
     if (o.t_start || o.t_end) {
       ref_kept = posefuse::reduce_to_time_range(*ref, o.t_start, o.t_end);
@@ -173,22 +188,24 @@ inline Evaluation evaluate(const EvaluationSetup& o, const LoadedTrajectory& ref
     }
     posefuse::AssociatedTrajectories sync =
         posefuse::associate(*ref, est, o.max_time_diff, o.t_offset, o.duplicates);
-    out.ref_used = std::move(sync.ref);
-    out.est_used = std::move(sync.est);
+    out.ref_kept = std::move(sync.ref);
+    out.est_kept = std::move(sync.est);
   }
-  if (o.align.n_to_align > out.ref_used.size()) {
+  const posefuse::Trajectory& ref_used = out.ref_used();
+  const posefuse::Trajectory& est_used = out.est_used();
+  if (o.align.n_to_align > ref_used.size()) {
     throw data_error("--n-to-align " + std::to_string(o.align.n_to_align) + " but only " +
-                     std::to_string(out.ref_used.size()) + " poses are associated");
+                     std::to_string(ref_used.size()) + " poses are associated");
   }
   try {
-    out.result = o.metric_rpe ? posefuse::rpe(out.ref_used, out.est_used, o.rpe)
-                              : posefuse::ape(out.ref_used, out.est_used, o.relation, o.align);
+    out.result = o.metric_rpe ? posefuse::rpe(ref_used, est_used, o.rpe)
+                              : posefuse::ape(ref_used, est_used, o.relation, o.align);
   } catch (const posefuse::invalid_argument& e) {
     // The library's reason names its function; say what it means for the files.
     const std::string what = e.what();
     const std::string files = o.groundtruth_name + " and " + o.estimate_name;
     if (what.find("degenerate") != std::string::npos || what.find("no horizontal spread") != std::string::npos)
-      throw data_error(files + ": the " + std::to_string(out.ref_used.size()) +
+      throw data_error(files + ": the " + std::to_string(ref_used.size()) +
                        " associated positions are all at one point or on one line, so --align " +
                        std::string(posefuse::to_string(o.align.alignment)) +
                        " has no unique answer (use --align none)");
@@ -198,7 +215,7 @@ inline Evaluation evaluate(const EvaluationSetup& o, const LoadedTrajectory& ref
   }
   if (o.align.project_to_plane && est_loaded.covariance_dim > 0 && !o.metric_rpe)
     throw usage_error("NEES (an estimate with covariance) cannot be combined with --project-to-plane");
-  out.nees = detail::consistency(o, est_loaded, out.ref_used, out.est_used, out.result);
+  out.nees = detail::consistency(o, est_loaded, ref_used, est_used, out.result);
   return out;
 }
 
@@ -266,9 +283,9 @@ inline std::string results_json(const EvaluationSetup& o, const Evaluation& e,
   // Stamps of the reference pose each error belongs to (RPE: the pair's end).
   j.key("stamps_s").begin_array();
   if (o.metric_rpe) {
-    for (const auto& pair : r.pairs) j.value(e.ref_used.t_s[pair.second]);
+    for (const auto& pair : r.pairs) j.value(e.ref_used().t_s[pair.second]);
   } else {
-    for (const double t : e.ref_used.t_s) j.value(t);
+    for (const double t : e.ref_used().t_s) j.value(t);
   }
   j.end_array();
   j.end_object().finish();

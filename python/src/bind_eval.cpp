@@ -270,7 +270,7 @@ document evaluate_trajectory --save-results writes for the same inputs.)doc")
             auto w = a.mutable_unchecked<1>();
             for (std::size_t k = 0; k < e.result.errors.size(); ++k)
               w(static_cast<py::ssize_t>(k)) =
-                  r.setup.metric_rpe ? e.ref_used.t_s[e.result.pairs[k].second] : e.ref_used.t_s[k];
+                  r.setup.metric_rpe ? e.ref_used().t_s[e.result.pairs[k].second] : e.ref_used().t_s[k];
             return a;
           },
           "(K,) the reference stamp of each error (RPE: of the pair's second pose)")
@@ -297,13 +297,13 @@ document evaluate_trajectory --save-results writes for the same inputs.)doc")
                              [](const ResultObject& r) { return std::string(apps::relation_name(r.setup.relation)); })
       .def_property_readonly("unit",
                              [](const ResultObject& r) { return std::string(posefuse::unit_of(r.setup.relation)); })
-      .def_property_readonly("ref", [](const ResultObject& r) { return wrap(r.evaluation.ref_used, r.setup.duplicates); },
+      .def_property_readonly("ref", [](const ResultObject& r) { return wrap(r.evaluation.ref_used(), r.setup.duplicates); },
                              "the associated reference poses (a Trajectory)")
-      .def_property_readonly("est", [](const ResultObject& r) { return wrap(r.evaluation.est_used, r.setup.duplicates); },
+      .def_property_readonly("est", [](const ResultObject& r) { return wrap(r.evaluation.est_used(), r.setup.duplicates); },
                              "the associated estimate poses, not aligned (a Trajectory)")
       .def_property_readonly("est_aligned",
                              [](const ResultObject& r) {
-                               return wrap(posefuse::apply_alignment(r.evaluation.est_used, r.evaluation.result.alignment),
+                               return wrap(posefuse::apply_alignment(r.evaluation.est_used(), r.evaluation.result.alignment),
                                            r.setup.duplicates);
                              },
                              "the associated estimate with the alignment applied")
@@ -329,7 +329,9 @@ document evaluate_trajectory --save-results writes for the same inputs.)doc")
       .def("__len__", [](const ResultObject& r) { return r.evaluation.result.errors.size(); })
       .def("__repr__", &result_repr);
 
-  m.def("ape", &ape, py::arg("ref"), py::arg("est"), py::kw_only(), py::arg("align") = "none",
+  // A Result may use the trajectories' poses as they are (frame by frame):
+  // it keeps them alive.
+  m.def("ape", &ape, py::keep_alive<0, 1>(), py::keep_alive<0, 2>(), py::arg("ref"), py::arg("est"), py::kw_only(), py::arg("align") = "none",
         py::arg("pose_relation") = "trans", py::arg("n_to_align") = py::none(), py::arg("align_origin") = false,
         py::arg("project_to_plane") = py::none(), py::arg("max_time_diff") = 0.01, py::arg("t_offset") = 0.0,
         py::arg("t_start") = py::none(), py::arg("t_end") = py::none(), py::arg("downsample") = py::none(),
@@ -350,7 +352,7 @@ pose_relation: 'trans', 'angle_deg', 'angle_rad', 'full', 'rot_part',
 DataError when the trajectories cannot be evaluated so (no matching stamps,
 a degenerate alignment, ...).)doc");
 
-  m.def("rpe", &rpe, py::arg("ref"), py::arg("est"), py::kw_only(), py::arg("delta") = 1.0,
+  m.def("rpe", &rpe, py::keep_alive<0, 1>(), py::keep_alive<0, 2>(), py::arg("ref"), py::arg("est"), py::kw_only(), py::arg("delta") = 1.0,
         py::arg("delta_unit") = "frames", py::arg("all_pairs") = false, py::arg("delta_tol") = 0.1,
         py::arg("pairs_from_reference") = false, py::arg("align") = "none", py::arg("pose_relation") = "trans",
         py::arg("n_to_align") = py::none(), py::arg("align_origin") = false, py::arg("project_to_plane") = py::none(),

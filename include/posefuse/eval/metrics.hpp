@@ -73,21 +73,39 @@ struct AlignmentOptions {
 
 namespace detail {
 
+/// The estimate and reference a metric compares: moved and projected
+/// copies where `options` asks for them, otherwise the inputs themselves
+/// (a 20,000-pose trajectory is 2.5 MB: not copied for nothing).
+struct PreparedForMetric {
+  AlignmentResult transform;                ///< the similarity applied to the estimate
+  std::optional<Trajectory> est_moved;      ///< aligned and/or projected estimate, if any
+  std::optional<Trajectory> ref_projected;  ///< projected reference, if projected
+  [[nodiscard]] const Trajectory& est(const Trajectory& input) const { return est_moved ? *est_moved : input; }
+  [[nodiscard]] const Trajectory& ref(const Trajectory& input) const { return ref_projected ? *ref_projected : input; }
+};
+
 /// Aligns and projects as `options` says (see AlignmentOptions); the
 /// reference is projected too.
 /// @throws posefuse::invalid_argument for Umeyama and origin alignment together
 template <class Lazy = void>
-std::pair<AlignedTrajectory, Trajectory> prepare_for_metric(const Trajectory& ref,
-                                                            const Trajectory& est,
-                                                            const AlignmentOptions& options) {
+PreparedForMetric prepare_for_metric(const Trajectory& ref, const Trajectory& est,
+                                     const AlignmentOptions& options) {
   if (options.align_origin && options.alignment != Alignment::kNone)
     throw invalid_argument("alignment: Umeyama alignment and origin alignment exclude each other");
-  AlignedTrajectory aligned = options.align_origin
-                                  ? align_origin(est, ref)
-                                  : align_trajectory(est, ref, options.alignment, options.n_to_align);
-  if (!options.project_to_plane) return {std::move(aligned), ref};
-  aligned.trajectory = project_poses_to_plane(aligned.trajectory, *options.project_to_plane);
-  return {std::move(aligned), project_poses_to_plane(ref, *options.project_to_plane)};
+  PreparedForMetric p;
+  if (options.align_origin || options.alignment != Alignment::kNone || options.n_to_align > est.size()) {
+    // (kNone with too large an n_to_align: align_trajectory's error.)
+    AlignedTrajectory aligned = options.align_origin
+                                    ? align_origin(est, ref)
+                                    : align_trajectory(est, ref, options.alignment, options.n_to_align);
+    p.transform = aligned.transform;
+    p.est_moved = std::move(aligned.trajectory);
+  }
+  if (options.project_to_plane) {
+    p.est_moved = project_poses_to_plane(p.est(est), *options.project_to_plane);
+    p.ref_projected = project_poses_to_plane(ref, *options.project_to_plane);
+  }
+  return p;
 }
 
 template <class Lazy = void>
@@ -124,12 +142,14 @@ template <class Lazy = void>
   detail::check_same_size(ref, est, "ape");
   if (relation == PoseRelation::kPointDistanceErrorRatio)
     throw invalid_argument("ape: point_distance_error_ratio is a relative (RPE) measure");
-  const auto [aligned, ref_used] = detail::prepare_for_metric(ref, est, alignment);
+  const detail::PreparedForMetric prepared = detail::prepare_for_metric(ref, est, alignment);
+  const Trajectory& est_used = prepared.est(est);
+  const Trajectory& ref_used = prepared.ref(ref);
   MetricResult r;
-  r.alignment = aligned.transform;
+  r.alignment = prepared.transform;
   r.errors.reserve(ref.size());
   for (std::size_t k = 0; k < ref.size(); ++k) {
-    const Eigen::Isometry3d& P = aligned.trajectory.poses[k];
+    const Eigen::Isometry3d& P = est_used.poses[k];
     const Eigen::Isometry3d& Q = ref_used.poses[k];
     r.errors.push_back(relation == PoseRelation::kTranslation ||
                                relation == PoseRelation::kPointDistance
@@ -203,14 +223,14 @@ template <class Lazy = void>
 [[nodiscard]] MetricResult rpe(const Trajectory& ref, const Trajectory& est,
                                const RpeOptions& options = {}) {
   detail::check_same_size(ref, est, "rpe");
-  const auto [aligned, ref_used] = detail::prepare_for_metric(
+  const detail::PreparedForMetric prepared = detail::prepare_for_metric(
       ref, est,
       AlignmentOptions{options.alignment, options.n_to_align, options.align_origin,
                        options.project_to_plane});
-  const std::vector<Eigen::Isometry3d>& P = aligned.trajectory.poses;
-  const std::vector<Eigen::Isometry3d>& Q = ref_used.poses;
+  const std::vector<Eigen::Isometry3d>& P = prepared.est(est).poses;
+  const std::vector<Eigen::Isometry3d>& Q = prepared.ref(ref).poses;
   MetricResult r;
-  r.alignment = aligned.transform;
+  r.alignment = prepared.transform;
   if (!(options.delta_tol >= 0.0) || !std::isfinite(options.delta_tol))
     throw invalid_argument("rpe: delta tolerance must be finite and >= 0");
   if (options.delta_unit == DeltaUnit::kFrames) {
