@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # Installs, from Debian's archive, the packages posefuse needs to build its
-# tests, examples and benchmarks -- and only those that are missing. Safe to
-# run again: on a machine that has them all it does nothing.
+# tests, examples, benchmarks and Python module (pybind11, Python headers,
+# numpy and pytest for its tests) -- and only those that are missing. Safe
+# to run again: on a machine that has them all it does nothing.
 set -euo pipefail
-packages=(cmake g++ make libeigen3-dev catch2 libbenchmark-dev)
+packages=(cmake g++ make libeigen3-dev catch2 libbenchmark-dev
+          pybind11-dev python3-dev python3-numpy python3-pytest)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
