@@ -267,3 +267,16 @@ def test_euroc_v101_ape_and_rpe(euroc_v101, program, tmp_path):
     assert r.to_json() == both(program, tmp_path, gt, est,
                                ["--delta", "1", "--delta-unit", "m", "--pose-relation", "angle_deg", "--align", "se3"],
                                ["--metric", "rpe"])
+
+
+def test_a_result_keeps_its_trajectories_alive(files):
+    # Frame by frame, a Result uses the trajectories' own poses (no copy).
+    gt = posefuse.read_trajectory(str(files / "gt.txt"))
+    est = posefuse.read_trajectory(str(files / "est.txt"))
+    expected = np.array(gt.positions)
+    r = posefuse.ape(gt, est, align="se3")
+    del gt, est
+    import gc
+    gc.collect()
+    assert np.array_equal(r.ref.positions, expected)
+    assert json.loads(r.to_json())["stamps_s"][-1] == 599.0
