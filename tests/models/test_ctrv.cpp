@@ -321,3 +321,18 @@ TEST_CASE("Ctrv: EKF and RTS on a vehicle circling through heading +-pi", "[mode
   CHECK(std::sqrt(smooth / 600) < 0.5 * sigma);
   CHECK(head < 0.05);  // no 2 pi jumps through the wrap
 }
+
+TEST_CASE("Ctrv<float>: the harness at float tolerance, yaw rate 0 and 1e-12 included",
+          "[models][ctrv][conformance]") {
+  const Ctrv<float> m(0.5f, 0.1f);
+  const auto fix = CtrvPositionFix<float>::isotropic(0.3f);
+  for (const float dt : {0.1f, 1.0f}) {
+    for (const float w : {0.0f, 1e-12f, 0.3f, -1.5f}) {
+      const CtrvState<float> x(1.5f, -2.0f, 2.9f, 4.0f, w);
+      const auto r = pt::check_motion_model(m, x, NoControl{}, dt, 3e-3);
+      INFO("w = " << w << ", dt = " << dt << ": " << r.message);
+      CHECK(r);
+      CHECK(pt::check_measurement_model(fix, x, 3e-3));
+    }
+  }
+}
