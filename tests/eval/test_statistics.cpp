@@ -1,8 +1,10 @@
 // Error statistics as evo/numpy define them (population std, numpy median).
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 #include <vector>
 
 #include <posefuse/eval/statistics.hpp>
@@ -43,4 +45,21 @@ TEST_CASE("Statistics: empty or non-finite input is rejected", "[eval][statistic
   CHECK_THROWS_AS(posefuse::compute_statistics(std::vector<double>{}), posefuse::invalid_argument);
   const std::vector<double> bad{1.0, std::numeric_limits<double>::quiet_NaN()};
   CHECK_THROWS_WITH(posefuse::compute_statistics(bad), Catch::Contains("error 1 is not finite"));
+}
+
+TEST_CASE("Statistics: median, min and max equal a full sort's on random series", "[eval][statistics]") {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(0.0, 10.0);
+  for (const std::size_t n : {1u, 2u, 3u, 10u, 11u, 1000u, 1001u}) {
+    std::vector<double> e(n);
+    for (double& x : e) x = u(rng);
+    if (n >= 10) e[3] = e[7];  // a repeated value
+    std::vector<double> sorted = e;
+    std::sort(sorted.begin(), sorted.end());
+    const posefuse::Statistics s = posefuse::compute_statistics(e);
+    const std::size_t mid = n / 2;
+    CHECK(s.median == (n % 2 == 1 ? sorted[mid] : 0.5 * (sorted[mid - 1] + sorted[mid])));
+    CHECK(s.min == sorted.front());
+    CHECK(s.max == sorted.back());
+  }
 }

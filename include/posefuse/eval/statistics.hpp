@@ -52,12 +52,16 @@ template <class Lazy = void>
   double var = 0.0;
   for (const double e : errors) var += (e - s.mean) * (e - s.mean);
   s.std = std::sqrt(var / n);
-  std::vector<double> sorted(errors.begin(), errors.end());
-  std::sort(sorted.begin(), sorted.end());
-  s.min = sorted.front();
-  s.max = sorted.back();
-  const std::size_t mid = sorted.size() / 2;
-  s.median = sorted.size() % 2 == 1 ? sorted[mid] : 0.5 * (sorted[mid - 1] + sorted[mid]);
+  const auto [lo, hi] = std::minmax_element(errors.begin(), errors.end());
+  s.min = *lo;
+  s.max = *hi;
+  // The middle value(s) by selection, O(n) as np.median's partition; the
+  // same elements a full sort would put there.
+  std::vector<double> v(errors.begin(), errors.end());
+  const std::size_t mid = v.size() / 2;
+  const auto middle = v.begin() + static_cast<std::ptrdiff_t>(mid);
+  std::nth_element(v.begin(), middle, v.end());
+  s.median = v.size() % 2 == 1 ? *middle : 0.5 * (*std::max_element(v.begin(), middle) + *middle);
   return s;
 }
 
