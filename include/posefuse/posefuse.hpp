@@ -44,6 +44,7 @@
 #include <posefuse/eval/statistics.hpp>
 #include <posefuse/filters/complementary.hpp>
 #include <posefuse/filters/ekf.hpp>
+#include <posefuse/filters/noise_tuning.hpp>
 #include <posefuse/filters/rts_smoother.hpp>
 #include <posefuse/fusion/fuse_poses.hpp>
 #include <posefuse/fusion/fuser_status.hpp>
@@ -53,6 +54,7 @@
 #include <posefuse/io/robot_log.hpp>
 #include <posefuse/lie/lie.hpp>
 #include <posefuse/models/constant_velocity.hpp>
+#include <posefuse/models/ctrv.hpp>
 #include <posefuse/models/heading_fix.hpp>
 #include <posefuse/models/planar_displacement.hpp>
 #include <posefuse/models/planar_pose.hpp>
