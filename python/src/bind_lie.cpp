@@ -78,15 +78,7 @@ struct Traits<SE3d> {
   static constexpr const char* name = "SE3";
   static constexpr int M = 4, D = 6, P = 3;
   static Shape tangent() { return {6}; }
-  static SE3d from(const double* p) {
-    const Eigen::Matrix4d T = read<4, 4>(p);
-    if (!((T.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff() <= kTol))
-      throw invalid_argument("SE3: bottom row of the matrix is not [0 0 0 1]");
-    Eigen::Isometry3d iso = Eigen::Isometry3d::Identity();
-    iso.linear() = T.topLeftCorner<3, 3>();
-    iso.translation() = T.topRightCorner<3, 1>();
-    return SE3d(iso);
-  }
+  static SE3d from(const double* p) { return se3_from_matrix(read<4, 4>(p)); }
   static void to(const SE3d& g, double* p) { write<4, 4>(p, g.matrix()); }
 };
 

@@ -13,11 +13,16 @@
 #include <pybind11/pybind11.h>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include <posefuse/core/error.hpp>
+#include <posefuse/lie/se3.hpp>
 
 namespace posefuse::python::math {
 
@@ -119,10 +124,13 @@ inline Stack rows_of(const py::handle& obj, py::ssize_t n, const Shape& tail, co
 
 /// `obj` as one item of shape `tail` (no leading dimensions).
 inline Stack single(const py::handle& obj, const Shape& tail, const std::string& what) {
-  Stack s = stack_of(obj, tail, what);
-  if (!s.lead.empty())
-    throw py::value_error(what + ": expected an array of shape " + exact_text(tail) + ", got " +
-                          shape_text(s.a));
+  Stack s;
+  s.a = to_array(obj, what);
+  bool ok = s.a.ndim() == py::ssize_t(tail.size());
+  for (std::size_t k = 0; ok && k < tail.size(); ++k) ok = s.a.shape(py::ssize_t(k)) == tail[k];
+  if (!ok)
+    throw py::value_error(what + ": expected an array of shape " + exact_text(tail) + ", got " + shape_text(s.a));
+  for (py::ssize_t d : tail) s.size *= d;
   return s;
 }
 
@@ -176,6 +184,36 @@ inline py::array_t<double> to_numpy(const Eigen::Matrix<double, R, C>& m) {
   py::array_t<double> out = C == 1 ? make({}, {R}) : make({}, {R, C});
   write<R, C>(out.mutable_data(), m);
   return out;
+}
+
+/// An integer array (any integer dtype) as int64 of shape (n,) (n = -1: any);
+/// TypeError for floats, None or anything else.
+inline py::array_t<std::int64_t> int_array(const py::handle& obj, py::ssize_t n, const std::string& what) {
+  if (obj.is_none()) throw py::type_error(what + ": expected an integer array, got None");
+  py::array a = py::array::ensure(obj);
+  if (!a) {
+    PyErr_Clear();
+    throw py::type_error(what + ": cannot be converted to an integer array");
+  }
+  const char kind = a.dtype().kind();
+  if (kind != 'i' && kind != 'u') throw py::type_error(what + ": expected integers, got dtype " + std::string(py::str(a.dtype())));
+  auto out = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(a);
+  if (out.ndim() != 1 || (n >= 0 && out.shape(0) != n))
+    throw py::value_error(what + ": expected an array of shape (" + (n >= 0 ? std::to_string(n) : std::string("N")) +
+                          ",), got " + shape_text(a));
+  return out;
+}
+
+/// The SE(3) element of a 4x4 homogeneous matrix, checked as the C++ isometry
+/// constructor checks it (rotation within 1e-5, finite translation), plus the
+/// bottom row [0 0 0 1] within 1e-5.
+inline SE3d se3_from_matrix(const Eigen::Matrix4d& T) {
+  if (!((T.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff() <= SO3d::kDefaultOrthonormalityTolerance))
+    throw invalid_argument("SE3: bottom row of the matrix is not [0 0 0 1]");
+  Eigen::Isometry3d iso = Eigen::Isometry3d::Identity();
+  iso.linear() = T.topLeftCorner<3, 3>();
+  iso.translation() = T.topRightCorner<3, 1>();
+  return SE3d(iso);
 }
 
 /// A finite real number or ValueError naming `what`.
