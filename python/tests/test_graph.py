@@ -332,3 +332,30 @@ def test_bad_g2o_files_raise_file_errors_with_file_and_line(tmp_path):
         pf.read_g2o(f)
     with pytest.raises(OSError, match="cannot open file for reading"):
         pf.read_g2o(tmp_path / "missing.g2o")
+
+
+@pytest.mark.parametrize("name", ["input_MITb_g2o.g2o", "manhattanOlson3500.g2o", "parking-garage.g2o"])
+def test_public_graphs_equal_the_cpp_program(name, data_dir, tmp_path):
+    f = data_dir / "posegraph" / name
+    if not f.is_file():
+        pytest.skip("%s not found under %s (set POSEFUSE_DATA_DIR)" % (name, f.parent))
+    prog = _program("optimize_pose_graph")
+    out = tmp_path / "opt.g2o"
+    proc = subprocess.run([str(prog), "--input", str(f), "--json", "--out", str(out)], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    ref = json.loads(proc.stdout)
+    g = pf.read_g2o(f)
+    assert (g.num_nodes, g.num_edges) == (ref["nodes"], ref["edges"])
+    assert g.cost() == ref["file_cost"]
+    if isinstance(g, pf.PoseGraph4Dof):
+        g.initialize_rotation_first()
+    else:
+        g.initialize_chordal()
+    assert g.cost() == ref["initial_cost"]
+    s = g.optimize()
+    assert (s.final_cost, s.iterations, s.termination) == (ref["final_cost"], ref["iterations"], ref["termination"])
+    back = pf.read_g2o(out)
+    if isinstance(g, pf.PoseGraph4Dof):
+        np.testing.assert_array_equal(g.poses, back.poses)
+    else:
+        np.testing.assert_allclose(g.poses, back.poses, rtol=0, atol=1e-12)
