@@ -169,7 +169,7 @@ def test_imu_factor_residual_matches_its_formula():
               xj.bias_accel - xi.bias_accel, xj.bias_gyro - xi.bias_gyro]
     np.testing.assert_allclose(f.residual(xi, xj), r, rtol=0, atol=1e-12)
     w = f.residual(xi, xj, whitened=True)
-    assert w @ w == pytest.approx(r @ np.linalg.solve(f.covariance, r), rel=1e-9)
+    assert w @ w == pytest.approx(r @ np.linalg.solve(f.covariance, r), rel=1e-12)
     np.testing.assert_allclose(f.whitening @ f.covariance @ f.whitening.T, np.eye(15), atol=1e-8)
     assert f.dt == pre.dt
     np.testing.assert_allclose(f.residual(xi, f.predict(xi)), np.zeros(15), atol=1e-12)
@@ -325,3 +325,60 @@ def test_interval_cut_with_interpolated_ends():
     np.testing.assert_allclose(pre.delta_p, dp, atol=1e-13)
     np.testing.assert_allclose(pre.delta_R, dR, atol=1e-13)
     np.testing.assert_allclose(pre.delta_v, dv, atol=1e-13)
+
+
+def test_euroc_windows_equal_imu_preintegration_check(data_dir):
+    """imu_preintegration_check's windows rebuilt in Python on EuRoC V1_01_easy: the same
+    pre-integration code, the error arithmetic in numpy: equal to 1e-12 relative."""
+    import json
+    import pathlib
+    import subprocess
+
+    d = data_dir / "euroc" / "V1_01_easy"
+    if not (d / "imu0.csv").is_file() or not (d / "groundtruth_20hz.csv").is_file():
+        pytest.skip("EuRoC V1_01_easy imu0.csv / groundtruth_20hz.csv not found under %s" % d)
+    prog = pathlib.Path(pf.__file__).resolve().parents[1] / "examples" / "imu_preintegration_check"
+    if not prog.is_file():
+        pytest.skip("imu_preintegration_check not built at %s" % prog)
+    proc = subprocess.run([str(prog), "--imu", str(d / "imu0.csv"), "--groundtruth", str(d / "groundtruth_20hz.csv"),
+                           "--window", "1", "--json"], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    ref = json.loads(proc.stdout)
+    imu = np.loadtxt(d / "imu0.csv", delimiter=",", comments="#", dtype=np.float64)
+    t_imu = np.loadtxt(d / "imu0.csv", delimiter=",", comments="#", usecols=0, dtype=np.int64)
+    gt = np.loadtxt(d / "groundtruth_20hz.csv", delimiter=",", comments="#", dtype=np.float64)
+    t_gt = np.loadtxt(d / "groundtruth_20hz.csv", delimiter=",", comments="#", usecols=0, dtype=np.int64)
+    R = pf.SO3.from_quaternion(gt[:, 4:8])
+    steps = np.diff(t_gt)
+    step = int(np.partition(steps, len(steps) // 2)[len(steps) // 2])
+    window = 10 ** 9
+    pos, rot, vel, nees = [], [], [], []
+    i = 0
+    while i + 1 < len(t_gt):
+        j = i + 1
+        while j < len(t_gt) and t_gt[j] - t_gt[i] < window - step // 2:
+            j += 1
+        if j == len(t_gt):
+            break
+        start, i = i, j
+        if np.any(np.diff(t_gt[start:j + 1]) > 2.5 * step):
+            continue
+        pre = pf.preintegrate(t_imu, imu[:, 4:7], imu[:, 1:4], bias_accel=gt[start, 14:17],
+                              bias_gyro=gt[start, 11:14], t0=int(t_gt[start]), t1=int(t_gt[j]))
+        T = pre.dt
+        Ri = R[start]
+        dp = Ri.T @ (gt[j, 1:4] - gt[start, 1:4] - gt[start, 8:11] * T - 0.5 * G * T * T)
+        dv = Ri.T @ (gt[j, 8:11] - gt[start, 8:11] - G * T)
+        e = np.r_[dp - pre.delta_p, pf.SO3.log(pre.delta_R.T @ Ri.T @ R[j]), dv - pre.delta_v]
+        P = pre.covariance[:9, :9]
+        pos.append(np.linalg.norm(e[:3]))
+        rot.append(np.degrees(np.linalg.norm(e[3:6])))
+        vel.append(np.linalg.norm(e[6:]))
+        nees.append(e @ np.linalg.solve(P, e))
+    assert len(pos) == ref["windows"]
+    rms = lambda v: math.sqrt(np.mean(np.square(v)))  # noqa: E731
+    assert rms(pos) == pytest.approx(ref["position_error_rmse"], rel=1e-12)
+    assert max(pos) == pytest.approx(ref["position_error_max"], rel=1e-12)
+    assert rms(rot) == pytest.approx(ref["rotation_error_rmse_deg"], rel=1e-12)
+    assert rms(vel) == pytest.approx(ref["velocity_error_rmse"], rel=1e-12)
+    assert np.mean(nees) == pytest.approx(ref["nees_mean"], rel=1e-12)
