@@ -41,6 +41,9 @@ struct EkfRun {
   std::vector<std::string> status;
 };
 
+/// A copy of a recorded array: the run stays as recorded whatever the caller does with it.
+py::array_t<double> copy(const py::array_t<double>& a) { return py::array_t<double>(a.attr("copy")()); }
+
 template <int D>
 Eigen::Matrix<double, D, 1> vec(const Eigen::Matrix<double, D, 1>& x) {
   return x;
@@ -254,16 +257,16 @@ constexpr const char* kRunDoc =
 
 void bind_filters(py::module_& m) {
   py::class_<EkfRun>(m, "EkfRun",
-                     "A recorded EKF run over N steps (read-only numpy arrays; D = state dimension, M = measurement "
-                     "dimension).")
+                     "A recorded EKF run over N steps (each property returns a copy of the recorded array; D = state "
+                     "dimension, M = measurement dimension).")
       .def_readonly("model", &EkfRun::model, "'seed000', 'constant_velocity', 'unicycle' or 'se2_odometry'")
-      .def_readonly("states", &EkfRun::states, "(N, D) filtered states")
-      .def_readonly("covariances", &EkfRun::covariances, "(N, D, D) filtered covariances")
-      .def_readonly("predicted_states", &EkfRun::predicted_states, "(N, D) predictions into step k")
-      .def_readonly("predicted_covariances", &EkfRun::predicted_covariances, "(N, D, D)")
-      .def_readonly("jacobians", &EkfRun::jacobians, "(N, D, D) F of the prediction into step k")
-      .def_readonly("nis", &EkfRun::nis, "(N,) normalised innovation squared (NaN where no update)")
-      .def_readonly("innovations", &EkfRun::innovations, "(N, M) innovations z (-) h(x) (NaN where no update)")
+      .def_property_readonly("states", [](const EkfRun& r) { return copy(r.states); }, "(N, D) filtered states")
+      .def_property_readonly("covariances", [](const EkfRun& r) { return copy(r.covariances); }, "(N, D, D) filtered covariances")
+      .def_property_readonly("predicted_states", [](const EkfRun& r) { return copy(r.predicted_states); }, "(N, D) predictions into step k")
+      .def_property_readonly("predicted_covariances", [](const EkfRun& r) { return copy(r.predicted_covariances); }, "(N, D, D)")
+      .def_property_readonly("jacobians", [](const EkfRun& r) { return copy(r.jacobians); }, "(N, D, D) F of the prediction into step k")
+      .def_property_readonly("nis", [](const EkfRun& r) { return copy(r.nis); }, "(N,) normalised innovation squared (NaN where no update)")
+      .def_property_readonly("innovations", [](const EkfRun& r) { return copy(r.innovations); }, "(N, M) innovations z (-) h(x) (NaN where no update)")
       .def_readonly("status", &EkfRun::status,
                     "per step: 'applied', 'rejected by gate', 'covariance not positive definite' or 'no measurement'")
       .def("__len__", [](const EkfRun& r) { return r.status.size(); })

@@ -457,7 +457,6 @@ void bind_graph(py::module_& m) {
           [](PoseGraph4Dof& g, const std::string& method, int max_it, double ft, double gt, double pt, double lam,
              bool planar) {
             const PoseGraphOptions o = options(method, max_it, ft, gt, pt, lam, planar);
-            py::gil_scoped_release release;
             return g.optimize(o);
           },
           PF_OPTIMIZE_ARGS, py::arg("planar_fast_path") = true,
@@ -554,7 +553,6 @@ void bind_graph(py::module_& m) {
           "optimize",
           [](PoseGraphSE3& g, const std::string& method, int max_it, double ft, double gt, double pt, double lam) {
             const PoseGraphOptions o = options(method, max_it, ft, gt, pt, lam, true);
-            py::gil_scoped_release release;
             return g.optimize(o);
           },
           PF_OPTIMIZE_ARGS, kOptimizeDoc)

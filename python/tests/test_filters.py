@@ -278,3 +278,14 @@ def test_bad_input_raises_with_the_cpp_messages():
     a = pf.ekf_seed000([0, 0], I2, u2, np.asfortranarray(z), I2, I2)
     b = pf.ekf_seed000(np.array([0, 0]), np.eye(2, dtype=int), np.ones((5, 2)), z, I2, I2)
     np.testing.assert_array_equal(a.states, b.states)
+
+
+def test_run_arrays_are_copies_so_the_run_stays_as_recorded():
+    u = np.ones((6, 2))
+    run = pf.ekf_seed000([0, 0], np.eye(2), u, np.cumsum(u, axis=0), np.eye(2) * 0.1, np.eye(2) * 0.1)
+    ref = pf.rts_smooth(run)
+    s = run.states
+    s[:] = np.nan
+    s.shape = (12,)
+    np.testing.assert_array_equal(pf.rts_smooth(run)[0], ref[0])
+    assert run.states.shape == (6, 2) and not np.isnan(run.states).any()
