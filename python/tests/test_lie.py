@@ -353,3 +353,33 @@ def test_bad_input_raises_with_the_cpp_messages():
 def test_tangents_and_points_are_not_validated_nan_in_nan_out():
     assert np.isnan(pf.SO3.exp([np.nan, 0.0, 0.0])).all()
     assert np.isnan(pf.SE3.act(np.eye(4), [np.nan, 0.0, 0.0])[0])
+
+
+@pytest.mark.parametrize("group", GROUPS)
+def test_misuse_sweep_raises_never_crashes(group):
+    M = G(group)
+    one = ["exp", "log", "inverse", "adjoint", "right_jacobian", "right_jacobian_inverse", "left_jacobian",
+           "left_jacobian_inverse", "hat", "vee", "normalize"]
+    two = ["compose", "between", "act", "plus", "minus"]
+    junk = [None, "abc", object(), np.zeros((2, 5, 7)), np.array([[1, 2], [3]], dtype=object)]
+    takes_tangent = {"exp", "right_jacobian", "right_jacobian_inverse", "left_jacobian", "left_jacobian_inverse",
+                     "hat", "plus"}
+    for name in one:
+        for j in junk:
+            if group == "SO2" and name in takes_tangent and isinstance(j, np.ndarray) and j.dtype != object:
+                continue  # SO2 tangents are scalars: any numeric shape is a stack of angles
+            with pytest.raises((TypeError, ValueError)):
+                getattr(M, name)(j)
+    good = M.identity()
+    for name in two:
+        for j in junk:
+            with pytest.raises((TypeError, ValueError)):
+                getattr(M, name)(j, j)
+            if group == "SO2" and name in takes_tangent and isinstance(j, np.ndarray) and j.dtype != object:
+                continue
+            with pytest.raises((TypeError, ValueError)):
+                getattr(M, name)(good, j)
+    # empty stacks are fine
+    empty = M.exp(np.zeros((0,) + ((DIM[group],) if group != "SO2" else ())))
+    assert empty.shape[0] == 0
+    assert M.compose(good, empty).shape == empty.shape
