@@ -383,3 +383,25 @@ def test_misuse_sweep_raises_never_crashes(group):
     empty = M.exp(np.zeros((0,) + ((DIM[group],) if group != "SO2" else ())))
     assert empty.shape[0] == 0
     assert M.compose(good, empty).shape == empty.shape
+
+
+def test_type_stubs_name_exactly_what_the_module_binds():
+    import ast
+    import pathlib
+
+    stub = pathlib.Path(pf.__file__).resolve().parent / "_math.pyi"
+    tree = ast.parse(stub.read_text())
+    classes = {n.name: n for n in tree.body if isinstance(n, ast.ClassDef)}
+    base = {n.name for n in classes.pop("_LieGroup").body if isinstance(n, ast.FunctionDef)}
+    funcs = {n.name for n in tree.body if isinstance(n, ast.FunctionDef)}
+    for name in funcs:
+        assert callable(getattr(pf, name)), name
+    for name, node in classes.items():
+        cls = getattr(pf, name)
+        declared = {n.name for n in node.body if isinstance(n, ast.FunctionDef)}
+        declared |= {n.target.id for n in node.body if isinstance(n, ast.AnnAssign)}
+        if any(isinstance(b, ast.Name) and b.id == "_LieGroup" for b in node.bases):
+            declared |= base
+        runtime = {a for a in dir(cls) if not a.startswith("_")}
+        public = {d for d in declared if not d.startswith("_")}
+        assert public == runtime, (name, public ^ runtime)
