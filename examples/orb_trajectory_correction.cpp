@@ -53,6 +53,7 @@
 #include <set>
 #include <string>
 #include <string_view>
+#include <tuple>
 #include <vector>
 
 #include <apps/cli.hpp>
@@ -78,6 +79,7 @@ struct Options {
   std::optional<fs::path> groundtruth, times, control, out, plot, sweep_svg;
   std::vector<fs::path> estimates;
   Format format = Format::kKitti;
+  bool auto_format = false;  ///< --format auto: each file's own (io/formats.hpp detect_format)
   Plane plane = Plane::kXZ;
   Eigen::Matrix2d R = Eigen::Matrix2d::Identity() * 0.01;
   Eigen::Matrix2d Q = Eigen::Matrix2d::Identity() * 0.25;
@@ -122,9 +124,15 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
             .help = "independent trajectory whose planar displacement is the control u\n"
                     "of method 'control' (associated with the estimate by timestamp)"},
            o.control);
-  cli.custom({.name = "--format", .value = "kitti|tum", .help = "format of all files",
+  cli.custom({.name = "--format", .value = "kitti|tum|auto",
+              .help = "format of all files; auto: each file's own (e.g. a TUM monocular\n"
+                      "estimate against KITTI ground truth, associated by timestamp)",
               .default_text = "kitti"},
              [&](std::string_view v) {
+               if (v == "auto") {
+                 o.auto_format = true;
+                 return;
+               }
                o.format = parse_format(v);
                if (o.format == Format::kEuroc)
                  throw apps::usage_error("expected kitti or tum (EuRoC files: evaluate_trajectory)");
@@ -205,9 +213,9 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   if (o.method.starts_with("control") && !o.control)
     throw apps::usage_error("--method " + o.method + " needs --control");
   if (o.sweep_svg && !o.sweep) throw apps::usage_error("--sweep-svg draws the --sweep grid; give --sweep");
-  if (tune_only && (o.out || o.plot || o.sweep || o.alignment != Alignment::kNone))
-    throw apps::usage_error("without --groundtruth, --tune only chooses noise: --out, --plot, --sweep "
-                            "and --align need --groundtruth");
+  if (tune_only && (o.out || o.plot || o.sweep))
+    throw apps::usage_error("without --groundtruth, --tune only chooses noise: --out, --plot and "
+                            "--sweep need --groundtruth");
 
   // Folder mode: --groundtruth DIR and one --estimate DIR (or --estimate DIR alone with --tune).
   const auto is_dir = [](const fs::path& p) { std::error_code ec; return fs::is_directory(p, ec); };
@@ -266,6 +274,7 @@ struct EstimateResult {
   double rmse_before = 0;
   std::vector<MethodResult> methods;
   std::vector<apps::seed000::TunedNoise> tuned;
+  Format format = Format::kKitti;  ///< the estimate file's, for --out
 };
 
 /// Throws a data error when `v` is not finite: no inf or nan reaches the output.
@@ -277,6 +286,25 @@ void require_finite(const std::vector<Eigen::Vector2d>& points, const std::strin
   for (std::size_t k = 0; k < points.size(); ++k)
     if (!points[k].allFinite())
       throw apps::data_error(what + " is not finite at frame " + std::to_string(k));
+}
+
+/// `base` with its road-plane coordinates replaced by `points` (height and
+/// attitude kept).
+Trajectory with_plane_points(const Trajectory& base, const std::vector<Eigen::Vector2d>& points,
+                             Plane plane) {
+  Trajectory out = base;
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    Eigen::Vector3d t = out.poses[k].translation();
+    const Eigen::Vector2d& p = points[k];
+    switch (plane) {
+      case Plane::kXZ: t.x() = p.x(); t.z() = p.y(); break;
+      case Plane::kXY: t.x() = p.x(); t.y() = p.y(); break;
+      case Plane::kYZ: t.y() = p.x(); t.z() = p.y(); break;
+    }
+    out.poses[k].translation() = t;
+  }
+  out.validate();
+  return out;
 }
 
 /// The frames of `est` that also have a control pose (by timestamp), with
@@ -305,16 +333,18 @@ Trajectory associate_control(const std::string& est_source, Trajectory& est, Tra
   return select(control, ci);
 }
 
+/// @param by_stamps associate the estimate with the ground truth by
+///        timestamp (a TUM file is involved), else pose by pose (KITTI)
 EstimateResult correct(std::string name, std::string source, const Trajectory* gt_full,
                        const Trajectory& est_full, const Trajectory* control_full,
-                       const std::string& control_source, const Options& o) {
+                       const std::string& control_source, bool by_stamps, const Options& o) {
   EstimateResult r;
   r.name = std::move(name);
   r.source = std::move(source);
   r.has_truth = gt_full != nullptr;
   if (!r.has_truth) {
     r.estimate = est_full;
-  } else if (o.format == Format::kTum) {
+  } else if (by_stamps) {
     const AssociatedTrajectories a = associate(*gt_full, est_full, o.max_time_diff);
     r.groundtruth = a.ref;
     r.estimate = a.est;
@@ -330,7 +360,19 @@ EstimateResult correct(std::string name, std::string source, const Trajectory* g
   if (control_full != nullptr)
     control = associate_control(r.source, r.estimate, r.has_truth ? &r.groundtruth : nullptr,
                                 *control_full, control_source, o.max_time_diff);
-  if (r.has_truth) r.estimate = align_trajectory(r.estimate, r.groundtruth, o.alignment).trajectory;
+  // The estimate in its own frame, with the control aligned to it: what
+  // --tune sees (the alignment to the ground truth would carry the truth's
+  // scale and orientation into the chosen noise).
+  const Trajectory own = r.estimate;
+  Trajectory own_control = control;
+  if (control_full != nullptr && o.alignment != Alignment::kNone)
+    own_control = align_trajectory(control, own, o.alignment).trajectory;
+  AlignmentResult to_truth;
+  if (r.has_truth) {
+    AlignedTrajectory aligned = align_trajectory(r.estimate, r.groundtruth, o.alignment);
+    r.estimate = std::move(aligned.trajectory);
+    to_truth = aligned.transform;
+  }
   if (control_full != nullptr && o.alignment != Alignment::kNone)
     control = align_trajectory(control, r.estimate, o.alignment).trajectory;
   r.raw_xy = project_to_plane(r.estimate, o.plane);
@@ -342,6 +384,13 @@ EstimateResult correct(std::string name, std::string source, const Trajectory* g
   if (control_full != nullptr) {
     r.input.control = project_to_plane(control, o.plane);
     require_finite(r.input.control, control_source + ": the control on the road plane");
+  }
+
+  apps::seed000::PlanarInput own_input = r.input;
+  if (o.alignment != Alignment::kNone) {
+    own_input.t = own.t_s;
+    own_input.z = project_to_plane(own, o.plane);
+    if (control_full != nullptr) own_input.control = project_to_plane(own_control, o.plane);
   }
 
   namespace s0 = apps::seed000;
@@ -363,14 +412,22 @@ EstimateResult correct(std::string name, std::string source, const Trajectory* g
   if (o.tune) {
     for (Family f : {Family::kCv, Family::kCtrv, Family::kControl}) {
       if (f == Family::kControl && control_full == nullptr) continue;
-      const s0::TunedNoise t = s0::tune_family(r.input, f);
+      const s0::TunedNoise t = s0::tune_family(own_input, f);
       r.tuned.push_back(t);
       if (!r.has_truth) continue;
+      // Run in the estimate's own frame, then moved by the raw estimate's alignment.
+      const auto to_aligned = [&](s0::MethodRun run) {
+        if (o.alignment == Alignment::kNone) return run;
+        const Trajectory moved = apply_alignment(with_plane_points(own, run.points, o.plane), to_truth);
+        run.points = project_to_plane(moved, o.plane);
+        for (double& v : run.variance) v *= to_truth.scale * to_truth.scale;
+        return run;
+      };
       std::optional<s0::MethodRun> smoothed;
       const std::string base = s0::family_name(f);
-      add(base + "/tuned", s0::run_family(r.input, f, t.result.process, t.result.measurement,
-                                          f == Family::kControl ? nullptr : &smoothed));
-      if (smoothed) add(base + "+rts/tuned", std::move(*smoothed));
+      add(base + "/tuned", to_aligned(s0::run_family(own_input, f, t.result.process, t.result.measurement,
+                                                     f == Family::kControl ? nullptr : &smoothed)));
+      if (smoothed) add(base + "+rts/tuned", to_aligned(std::move(*smoothed)));
     }
   }
   if (!r.has_truth) return r;
@@ -451,19 +508,7 @@ std::pair<std::size_t, double> steady_state(const std::vector<double>& v) {
 
 /// The estimate with the method's road-plane positions (height, attitude kept).
 Trajectory corrected_trajectory(const EstimateResult& r, const MethodResult& m, Plane plane) {
-  Trajectory out = r.estimate;
-  for (std::size_t k = 0; k < out.size(); ++k) {
-    Eigen::Vector3d t = out.poses[k].translation();
-    const Eigen::Vector2d& p = m.points[k];
-    switch (plane) {
-      case Plane::kXZ: t.x() = p.x(); t.z() = p.y(); break;
-      case Plane::kXY: t.x() = p.x(); t.y() = p.y(); break;
-      case Plane::kYZ: t.y() = p.x(); t.z() = p.y(); break;
-    }
-    out.poses[k].translation() = t;
-  }
-  out.validate();
-  return out;
+  return with_plane_points(r.estimate, m.points, plane);
 }
 
 /// Left: the first estimate's road-plane paths. Right: seed 000 Fig. 8, the
@@ -493,7 +538,7 @@ std::string plot_svg(const EstimateResult& r, Plane plane) {
 }
 
 /// The tuned noise levels, one line per estimate and method.
-void print_tuned(const std::vector<EstimateResult>& results) {
+void print_tuned(const Options& o, const std::vector<EstimateResult>& results) {
   std::printf("\nNoise chosen by the innovation likelihood of each estimate alone (no ground truth):\n\n");
   for (const auto& r : results)
     for (const auto& t : r.tuned) {
@@ -507,6 +552,9 @@ void print_tuned(const std::vector<EstimateResult>& results) {
   std::printf("\nX/tuned and X+rts/tuned share the X filter's values. seed000 is not tuned: its "
               "innovations are zero\n(it returns its input), so its likelihood only grows as R and Q "
               "shrink.\n");
+  if (o.alignment != Alignment::kNone)
+    std::printf("With --align the noise is chosen in each estimate's own frame and units, before "
+                "the alignment.\n");
 }
 
 void print_json(const Options& o, const std::vector<EstimateResult>& results) {
@@ -586,7 +634,7 @@ void print_json(const Options& o, const std::vector<EstimateResult>& results) {
 
 void print_table(const Options& o, const std::vector<EstimateResult>& results) {
   if (!results.front().has_truth) {
-    print_tuned(results);
+    print_tuned(o, results);
     return;
   }
   std::size_t width = 8;
@@ -614,7 +662,7 @@ void print_table(const Options& o, const std::vector<EstimateResult>& results) {
               results.front().methods[0].variance.front(), steady_value, steady_frame);
   std::printf("seed000 returns its input whatever R and Q (u = z_t - z_{t-1} cancels the gain; "
               "docs/reproductions.md).\n");
-  if (o.tune) print_tuned(results);
+  if (o.tune) print_tuned(o, results);
 }
 
 /// One sequence's files.
@@ -660,17 +708,33 @@ int run(const Options& o) {
   if (o.estimates.empty()) {
     const sim::SyntheticDrive drive = sim::make_kitti_like_drive();
     results.push_back(correct("synthetic", "built-in synthetic drive", &drive.groundtruth,
-                              drive.estimate, nullptr, {}, o));
+                              drive.estimate, nullptr, {}, o.format == Format::kTum, o));
+    results.back().format = o.format;
   } else {
     for (const SequenceFiles& s : sequences(o)) {
-      const auto times = o.format == Format::kKitti ? s.times : std::nullopt;
+      const auto format_of = [&](const fs::path& p) {
+        if (!o.auto_format) return o.format;
+        const Format f = detect_format(p);
+        if (f == Format::kEuroc)
+          throw apps::data_error(p.string() + ": a EuRoC file (read those with evaluate_trajectory)");
+        return f;
+      };
+      const auto read = [&](const fs::path& p, Format f) {
+        return read_trajectory(p, f, f == Format::kKitti ? s.times : std::nullopt);
+      };
       std::optional<Trajectory> gt, control;
-      if (s.groundtruth) gt = read_trajectory(*s.groundtruth, o.format, times);
-      if (s.control) control = read_trajectory(*s.control, o.format, times);
+      const Format est_format = format_of(s.estimate);
+      bool by_stamps = est_format == Format::kTum;
+      if (s.groundtruth) {
+        const Format f = format_of(*s.groundtruth);
+        by_stamps = by_stamps || f == Format::kTum;
+        gt = read(*s.groundtruth, f);
+      }
+      if (s.control) control = read(*s.control, format_of(*s.control));
       results.push_back(correct(s.name, s.estimate.string(), gt ? &*gt : nullptr,
-                                read_trajectory(s.estimate, o.format, times),
-                                control ? &*control : nullptr,
-                                s.control ? s.control->string() : std::string(), o));
+                                read(s.estimate, est_format), control ? &*control : nullptr,
+                                s.control ? s.control->string() : std::string(), by_stamps, o));
+      results.back().format = est_format;
     }
   }
   std::vector<apps::seed000::SweepTable> sweep;
@@ -688,21 +752,23 @@ int run(const Options& o) {
   // 2. The output files, in memory (the SVG refuses non-finite numbers).
   apps::OutputFiles files;
   if (o.out) {
-    const std::string ext = o.format == Format::kTum ? ".tum" : ".txt";
-    std::vector<std::pair<std::string, Trajectory>> corrected;
+    std::vector<std::tuple<std::string, Trajectory, Format>> corrected;
     for (const auto& r : results) {
+      const std::string ext = r.format == Format::kTum ? ".tum" : ".txt";
       const auto m = std::find_if(r.methods.begin(), r.methods.end(),
                                   [&](const MethodResult& x) { return x.name == o.method; });
       const std::string file = r.name + "_" + std::string(o.method.substr(0, o.method.find('/'))) +
                                (o.method.ends_with("/tuned") ? "_tuned" : "") + ext;
-      corrected.emplace_back(file, corrected_trajectory(r, *m, o.plane));
+      corrected.emplace_back(file, corrected_trajectory(r, *m, o.plane), r.format);
     }
     if (results.size() == 1 && !o.folders) {
-      files.add_with(*o.out, [t = std::move(corrected.front().second), f = o.format](
-                                 const fs::path& p) { write_trajectory(p, t, f); });
+      files.add_with(*o.out, [t = std::move(std::get<1>(corrected.front())),
+                              f = std::get<2>(corrected.front())](const fs::path& p) {
+        write_trajectory(p, t, f);
+      });
     } else {
-      files.add_folder(*o.out, [c = std::move(corrected), f = o.format](const fs::path& dir) {
-        for (const auto& [name, t] : c) write_trajectory(dir / name, t, f);
+      files.add_folder(*o.out, [c = std::move(corrected)](const fs::path& dir) {
+        for (const auto& [name, t, f] : c) write_trajectory(dir / name, t, f);
       });
     }
   }

@@ -169,22 +169,29 @@ TEST_CASE("seed000 study: --tune recovers the generating noise and never reads t
   CHECK((*t)["measurement"].number() == Approx(0.25).epsilon(0.30));
   CHECK_FALSE((*t)["at_bound"].boolean());
 
-  // With either ground truth the chosen values are the same, to the bit.
-  for (const fs::path& g : {gt, gt2}) {
-    const auto with = posefuse::test::run(exe, "--groundtruth '" + g.string() + "'" + inputs, dir);
-    REQUIRE(with.status == 0);
-    const Json w = Json::parse(with.out);
-    const Json& wt = w["estimates"][0]["tuned"];
-    REQUIRE(wt.array().size() == tuned.array().size());
-    for (std::size_t k = 0; k < wt.array().size(); ++k) {
-      INFO(g.filename().string() << " " << wt[k]["method"].string());
-      CHECK(wt[k]["method"].string() == tuned[k]["method"].string());
-      CHECK(wt[k]["process"].number() == tuned[k]["process"].number());
-      CHECK(wt[k]["measurement"].number() == tuned[k]["measurement"].number());
-      CHECK(wt[k]["log_likelihood"].number() == tuned[k]["log_likelihood"].number());
+  // With either ground truth, aligned to it or not, the chosen values are
+  // those of the run without ground truth, to the bit (with --align the
+  // filters are tuned in the estimate's own frame; the control is aligned
+  // to the estimate, not to the truth).
+  for (const std::string align : {"", " --align sim3", " --align se3"}) {
+    const Json base = Json::parse(posefuse::test::run(exe, inputs + align, dir).out);
+    const Json& expected = base["estimates"][0]["tuned"];
+    for (const fs::path& g : {gt, gt2}) {
+      const auto with = posefuse::test::run(exe, "--groundtruth '" + g.string() + "'" + inputs + align, dir);
+      REQUIRE(with.status == 0);
+      const Json w = Json::parse(with.out);
+      const Json& wt = w["estimates"][0]["tuned"];
+      REQUIRE(wt.array().size() == expected.array().size());
+      for (std::size_t k = 0; k < wt.array().size(); ++k) {
+        INFO(g.filename().string() << align << " " << wt[k]["method"].string());
+        CHECK(wt[k]["method"].string() == expected[k]["method"].string());
+        CHECK(wt[k]["process"].number() == expected[k]["process"].number());
+        CHECK(wt[k]["measurement"].number() == expected[k]["measurement"].number());
+        CHECK(wt[k]["log_likelihood"].number() == expected[k]["log_likelihood"].number());
+      }
+      REQUIRE(find_method(w["estimates"][0]["methods"], "control/tuned") != nullptr);
+      check_verdicts_strict(w);
     }
-    REQUIRE(find_method(w["estimates"][0]["methods"], "control/tuned") != nullptr);
-    check_verdicts_strict(w);
   }
   // The tuned control fuses as well as the generator's values do.
   const auto with = posefuse::test::run(exe, "--groundtruth '" + gt.string() + "'" + inputs, dir);
@@ -221,6 +228,31 @@ TEST_CASE("seed000 study: control association errors name the file", "[examples]
     CHECK(r.err.find(c.expect) != std::string::npos);
     CHECK(r.out.empty());
   }
+}
+
+TEST_CASE("seed000 study: --format auto scores a TUM estimate against KITTI ground truth", "[examples][seed000]") {
+  POSEFUSE_REQUIRE_EXAMPLE(exe, "orb_trajectory_correction");
+  posefuse::test::TempDir dir("seed000-study");
+  const ControlCase c = make_control_case(0.3, 0.02, 31, 100.0);
+  const fs::path gt = dir.path() / "gt.txt", times = dir.path() / "times.txt", est = dir.path() / "est.tum";
+  posefuse::write_kitti(gt, c.truth);
+  posefuse::write_kitti_times(times, c.truth);
+  Trajectory shifted = c.estimate;  // stamps offset by 2 ms: associated within 10 ms
+  for (double& t : shifted.t_s) t += 0.002;
+  posefuse::write_tum(est, shifted);
+  const std::string args = "--groundtruth '" + gt.string() + "' --times '" + times.string() +
+                           "' --estimate '" + est.string() + "' --json";
+  const auto r = posefuse::test::run(exe, "--format auto " + args, dir);
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  const Json j = Json::parse(r.out);
+  CHECK(j["estimates"][0]["frames"].number() == double(c.truth.size()));
+  CHECK(j["estimates"][0]["rmse_before"].number() == Approx(0.3 * std::sqrt(2.0)).epsilon(0.15));
+  // Without auto the TUM file is read as KITTI and refused with its line.
+  const auto k = posefuse::test::run(exe, args, dir);
+  INFO(k.err);
+  CHECK(k.status == 1);
+  CHECK(k.err.find("est.tum:2: expected 12") != std::string::npos);  // line 1 is write_tum's comment
 }
 
 TEST_CASE("seed000 study: folder mode, one row per sequence and method and a strict mean row",
