@@ -20,7 +20,8 @@
 // scores the result); --sweep prints the RMSE over a grid of noise levels
 // (apps/seed000_sweep.hpp) and --sweep-svg draws it. --groundtruth and
 // --estimate may be folders of same-named files: one row per sequence and
-// method, and a mean row.
+// method, and a mean row. --format auto reads each file in its own format (a
+// TUM monocular estimate against KITTI ground truth, with --align sim3).
 //
 // With no arguments it runs on a built-in synthetic drive (a KITTI-06-like
 // 1.2 km loop with heading drift, scale error and 0.35 m position jitter;

@@ -367,4 +367,11 @@ TEST_CASE("seed000 study: KITTI 06 with an independent control, tuned, both ways
   CHECK((*find_method(jb["estimates"][0]["methods"], "control"))["rmse_after"].number() ==
         Approx(15.051).margin(5e-4));
   check_verdicts_strict(jb);
+  // The TUM monocular output against the KITTI ground truth, Sim(3)-aligned.
+  const auto m = posefuse::test::run(
+      exe, base + " --format auto --align sim3 --estimate '" + (kitti / "orbslam2_mono.tum").string() + "'", dir);
+  REQUIRE(m.status == 0);
+  const Json jm = Json::parse(m.out);
+  CHECK(jm["estimates"][0]["rmse_before"].number() == Approx(12.976).margin(5e-4));
+  check_verdicts_strict(jm);
 }
