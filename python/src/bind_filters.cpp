@@ -269,10 +269,10 @@ void bind_filters(py::module_& m) {
       .def_property_readonly("innovations", [](const EkfRun& r) { return copy(r.innovations); }, "(N, M) innovations z (-) h(x) (NaN where no update)")
       .def_readonly("status", &EkfRun::status,
                     "per step: 'applied', 'rejected by gate', 'covariance not positive definite' or 'no measurement'")
-      .def("__len__", [](const EkfRun& r) { return r.status.size(); })
+      .def("__len__", [](const EkfRun& r) { return r.status.size(); }, "number of steps N")
       .def("__repr__", [](const EkfRun& r) {
         return "EkfRun(model='" + r.model + "', steps=" + std::to_string(r.status.size()) + ")";
-      });
+      }, "Model and number of steps.");
 
   m.def("ekf_seed000", &ekf_seed000, py::arg("x0"), py::arg("P0"), py::arg("displacements"), py::arg("fixes"),
         py::arg("R"), py::arg("Q"), py::arg("mask") = py::none(), py::arg("gate") = std::numeric_limits<double>::infinity(),

@@ -353,7 +353,7 @@ void bind_graph(py::module_& m) {
                ", iterations=" + std::to_string(s.iterations) + ", accepted=" + std::to_string(s.accepted) +
                ", termination='" + std::string(to_string(s.termination)) + "', solve_time_s=" +
                std::string(py::repr(py::float_(s.solve_time_s))) + ", planar=" + (s.planar ? "True" : "False") + ")";
-      });
+      }, "All fields.");
 
   py::class_<PoseGraph4Dof>(
       m, "PoseGraph4Dof",
@@ -384,7 +384,7 @@ void bind_graph(py::module_& m) {
       .def("is_fixed", &PoseGraph4Dof::is_fixed, py::arg("id"), "True when node `id` is held fixed.")
       .def_property_readonly("num_nodes", &PoseGraph4Dof::num_nodes, "number of nodes")
       .def_property_readonly("num_edges", &PoseGraph4Dof::num_edges, "number of edges")
-      .def("__len__", &PoseGraph4Dof::num_nodes)
+      .def("__len__", &PoseGraph4Dof::num_nodes, "number of nodes")
       .def_property_readonly("ids", &ids_of<PoseGraph4Dof>, "node ids (N,) int64, insertion order")
       .def_property_readonly("fixed", &fixed_of<PoseGraph4Dof>, "(N,) bool: node held fixed")
       .def_property_readonly("poses", &poses4, "(N, 4) [x, y, z, yaw] in insertion order (a copy)")
@@ -465,7 +465,7 @@ void bind_graph(py::module_& m) {
       .def("__repr__", [](const PoseGraph4Dof& g) {
         return "PoseGraph4Dof(num_nodes=" + std::to_string(g.num_nodes()) + ", num_edges=" + std::to_string(g.num_edges()) +
                ")";
-      });
+      }, "Sizes of the graph.");
 
   py::class_<PoseGraphSE3>(
       m, "PoseGraphSE3",
@@ -507,7 +507,7 @@ void bind_graph(py::module_& m) {
       .def("is_fixed", &PoseGraphSE3::is_fixed, py::arg("id"), "True when node `id` is held fixed.")
       .def_property_readonly("num_nodes", &PoseGraphSE3::num_nodes, "number of nodes")
       .def_property_readonly("num_edges", &PoseGraphSE3::num_edges, "number of edges")
-      .def("__len__", &PoseGraphSE3::num_nodes)
+      .def("__len__", &PoseGraphSE3::num_nodes, "number of nodes")
       .def_property_readonly("ids", &ids_of<PoseGraphSE3>, "node ids (N,) int64, insertion order")
       .def_property_readonly("fixed", &fixed_of<PoseGraphSE3>, "(N,) bool: node held fixed")
       .def_property_readonly("poses", &poses3, "(N, 4, 4) node poses in insertion order (a copy)")
@@ -559,7 +559,7 @@ void bind_graph(py::module_& m) {
       .def("__repr__", [](const PoseGraphSE3& g) {
         return "PoseGraphSE3(num_nodes=" + std::to_string(g.num_nodes()) + ", num_edges=" + std::to_string(g.num_edges()) +
                ")";
-      });
+      }, "Sizes of the graph.");
 
   m.def("read_g2o", &read_g2o, py::arg("path"), py::arg("loss") = "none", py::arg("loss_scale") = 1.0,
         "Reads a g2o file: VERTEX_SE2 / EDGE_SE2 gives a (planar) PoseGraph4Dof, VERTEX_SE3:QUAT / EDGE_SE3:QUAT a "

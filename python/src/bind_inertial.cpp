@@ -87,8 +87,14 @@ Preintegration preintegrate(const py::object& t_, const py::object& acc_, const 
     samples[k].gyro_radps = read<3, 1>(gyro.item(py::ssize_t(k)));
   }
   const auto stamp = [&](const py::object& o, const char* what) -> std::int64_t {
-    if (seconds) return to_ns(o.cast<double>(), std::string("preintegrate: ") + what);
-    return o.cast<std::int64_t>();
+    if (seconds) {
+      if (!py::isinstance<py::float_>(o) && !py::isinstance<py::int_>(o) && !py::hasattr(o, "__float__"))
+        throw py::type_error(std::string("preintegrate: ") + what + ": expected a time in seconds, like t");
+      return to_ns(py::float_(o).cast<double>(), std::string("preintegrate: ") + what);
+    }
+    if (!py::hasattr(o, "__index__"))
+      throw py::type_error(std::string("preintegrate: ") + what + ": expected an integer time in ns, like t");
+    return py::int_(o).cast<std::int64_t>();
   };
   const auto sample_text = [&](std::size_t k) {
     return "sample " + std::to_string(k) + " (t = " + std::to_string(samples[k].t_ns) + " ns)";
@@ -230,7 +236,7 @@ void bind_inertial(py::module_& m) {
                ", accel_noise_density=" + std::string(py::repr(py::float_(n.accel_noise_density))) +
                ", gyro_random_walk=" + std::string(py::repr(py::float_(n.gyro_random_walk))) +
                ", accel_random_walk=" + std::string(py::repr(py::float_(n.accel_random_walk))) + ")";
-      });
+      }, "All four figures.");
 
   py::class_<Preintegration>(
       m, "Preintegration",
@@ -277,7 +283,7 @@ void bind_inertial(py::module_& m) {
       .def("__repr__", [](const Preintegration& p) {
         return "Preintegration(dt=" + std::string(py::repr(py::float_(p.dt_s()))) +
                ", sample_count=" + std::to_string(p.sample_count()) + ")";
-      });
+      }, "Interval length and sample count.");
 
   m.def("preintegrate", &preintegrate, py::arg("t"), py::arg("accel"), py::arg("gyro"),
         py::arg("bias_accel") = std::array<double, 3>{0, 0, 0}, py::arg("bias_gyro") = std::array<double, 3>{0, 0, 0},
@@ -309,7 +315,18 @@ void bind_inertial(py::module_& m) {
           py::arg("d"), "x (+) d for d (15,) [dp, dphi, dv, dba, dbg].")
       .def(
           "minus", [](const ImuState& y, const ImuState& x) { return to_numpy<15, 1>(y.minus(x)); }, py::arg("x"),
-          "y (-) x (15,) (this = y).");
+          "y (-) x (15,) (this = y).")
+      .def(
+          "__repr__",
+          [](const ImuState& x) {
+            const auto v3 = [](const Eigen::Vector3d& v) {
+              return "[" + std::string(py::repr(py::float_(v.x()))) + ", " + std::string(py::repr(py::float_(v.y()))) +
+                     ", " + std::string(py::repr(py::float_(v.z()))) + "]";
+            };
+            return "ImuState(p=" + v3(x.p) + ", phi=" + v3(x.R.log()) + ", v=" + v3(x.v) + ", bias_accel=" +
+                   v3(x.bias.accel) + ", bias_gyro=" + v3(x.bias.gyro) + ")";
+          },
+          "The state, attitude as its rotation vector phi.");
 
   py::class_<ImuFactor>(m, "ImuFactor",
                         "The IMU factor of one pre-integrated interval (Forster et al. 2017 eq 45; VINS-Mono eq 16): "

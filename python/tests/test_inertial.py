@@ -296,6 +296,10 @@ def test_bad_input_raises_with_the_cpp_messages():
         pf.preintegrate(np.array(["a"] * 10), acc, gyro)
     with pytest.raises(ValueError, match="samples do not cover the interval"):
         pf.preintegrate(t, acc, gyro, t0=int(t[0]) - 5, t1=int(t[-1]))
+    with pytest.raises(TypeError, match="t0: expected an integer time in ns, like t"):
+        pf.preintegrate(t, acc, gyro, t0=float(t[1]), t1=int(t[-1]))
+    with pytest.raises(ValueError, match="give both t0 and t1, or neither"):
+        pf.preintegrate(t, acc, gyro, t0=int(t[1]))
     with pytest.raises(ValueError, match=r"ImuNoise: gyro_noise_density must be finite and >= 0, got -1"):
         pf.ImuNoise(gyro_noise_density=-1.0)
     with pytest.raises(ValueError, match="Preintegration: bias is not finite"):
