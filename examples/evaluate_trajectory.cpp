@@ -476,7 +476,8 @@ int run_read(const Options& given, apps::SpooledInputs& spool) {
   for (const std::string& w : warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   progress.stage("associating " + std::to_string(ref_file.size()) + " and " + std::to_string(est_file.size()) +
                  " poses");
-  const apps::Evaluation evaluation = apps::evaluate(o, ref_loaded, est_loaded);
+  const apps::Evaluation evaluation =
+      apps::evaluate(o, ref_loaded, est_loaded, [&](const std::string& what) { progress.stage(what); });
   const posefuse::MetricResult& result = evaluation.result;
   const std::optional<posefuse::NeesResult>& nees = evaluation.nees;
   progress.clear();

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <functional>
 #include <numbers>
 #include <optional>
 #include <sstream>
@@ -146,10 +147,12 @@ inline std::optional<posefuse::NeesResult> consistency(const EvaluationSetup& o,
 /// Evaluates `est` against `ref` as `o` says, in evo's order:
 /// --downsample/--motion-filter, --t-start/--t-end (REF), association
 /// (--t-offset) or frame by frame, alignment, --project-to-plane, metric.
+/// `stage`, when given, is told before the metric ("APE of N pose pairs").
 /// @throws apps::data_error (bad data, naming the files) and
 ///         apps::usage_error (NEES with --project-to-plane)
 inline Evaluation evaluate(const EvaluationSetup& o, const LoadedTrajectory& ref_loaded,
-                           const LoadedTrajectory& est_loaded) {
+                           const LoadedTrajectory& est_loaded,
+                           const std::function<void(const std::string&)>& stage = {}) {
   const posefuse::Trajectory& ref_file = ref_loaded.trajectory;
   const posefuse::Trajectory& est_file = est_loaded.trajectory;
   // Thinned copies only when thinning is asked for; otherwise the poses as
@@ -197,6 +200,7 @@ inline Evaluation evaluate(const EvaluationSetup& o, const LoadedTrajectory& ref
     throw data_error("--n-to-align " + std::to_string(o.align.n_to_align) + " but only " +
                      std::to_string(ref_used.size()) + " poses are associated");
   }
+  if (stage) stage(std::string(o.metric_rpe ? "RPE" : "APE") + " of " + std::to_string(ref_used.size()) + " pose pairs");
   try {
     out.result = o.metric_rpe ? posefuse::rpe(ref_used, est_used, o.rpe)
                               : posefuse::ape(ref_used, est_used, o.relation, o.align);
