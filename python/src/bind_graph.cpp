@@ -422,13 +422,13 @@ void bind_graph(py::module_& m) {
           "edges",
           [](const PoseGraph4Dof& g) {
             require_numpy("PoseGraph4Dof.edges");
-            const py::ssize_t m = py::ssize_t(g.num_edges());
-            py::array_t<std::int64_t> from(m), to(m);
-            auto dp = make({m}, {3});
-            auto dyaw = make({m}, {});
-            auto info = make({m}, {4, 4});
+            const py::ssize_t ne = py::ssize_t(g.num_edges());
+            py::array_t<std::int64_t> from(ne), to(ne);
+            auto dp = make({ne}, {3});
+            auto dyaw = make({ne}, {});
+            auto info = make({ne}, {4, 4});
             py::list loss;
-            for (py::ssize_t e = 0; e < m; ++e) {
+            for (py::ssize_t e = 0; e < ne; ++e) {
               const Edge4Dof& ed = g.edges()[std::size_t(e)];
               from.mutable_at(e) = ed.from;
               to.mutable_at(e) = ed.to;
@@ -525,12 +525,12 @@ void bind_graph(py::module_& m) {
           "edges",
           [](const PoseGraphSE3& g) {
             require_numpy("PoseGraphSE3.edges");
-            const py::ssize_t m = py::ssize_t(g.num_edges());
-            py::array_t<std::int64_t> from(m), to(m);
-            auto T = make({m}, {4, 4});
-            auto info = make({m}, {6, 6});
+            const py::ssize_t ne = py::ssize_t(g.num_edges());
+            py::array_t<std::int64_t> from(ne), to(ne);
+            auto T = make({ne}, {4, 4});
+            auto info = make({ne}, {6, 6});
             py::list loss;
-            for (py::ssize_t e = 0; e < m; ++e) {
+            for (py::ssize_t e = 0; e < ne; ++e) {
               const EdgeSE3& ed = g.edges()[std::size_t(e)];
               from.mutable_at(e) = ed.from;
               to.mutable_at(e) = ed.to;

@@ -130,7 +130,7 @@ py::object corrected(const Preintegration& p, const py::object& ba, const py::ob
   out[1] = to_numpy<3, 3>(d.R.matrix());
   out[2] = to_numpy<3, 1>(d.v);
   if (jacobian) out[3] = to_numpy<9, 6>(J);
-  return std::move(out);
+  return out;
 }
 
 // ---- ImuState ------------------------------------------------------------------
@@ -176,7 +176,7 @@ py::object align_n(const Stack& T, const SE3d& T_b_c, const std::vector<Preinteg
   d["T_w_b"] = Tw;
   d["velocity_w"] = vw;
   d["preintegrations"] = py::cast(pre);
-  return std::move(d);
+  return d;
 }
 
 template <int N>

@@ -117,7 +117,7 @@ struct Ops {
       if (jacobian) write<D, D>(J.mutable_data() + i * D * D, Ji);
     }
     if (jacobian) return py::make_tuple(out, J);
-    return std::move(out);
+    return out;
   }
 
   static py::object log(const py::object& g_, bool jacobian) {
@@ -130,7 +130,7 @@ struct Ops {
       if (jacobian) write<D, D>(J.mutable_data() + i * D * D, Ji);
     }
     if (jacobian) return py::make_tuple(out, J);
-    return std::move(out);
+    return out;
   }
 
   static py::object inverse(const py::object& g_, bool jacobian) {
@@ -143,7 +143,7 @@ struct Ops {
       if (jacobian) write<D, D>(J.mutable_data() + i * D * D, Ji);
     }
     if (jacobian) return py::make_tuple(out, J);
-    return std::move(out);
+    return out;
   }
 
   /// compose / between: c = op(a, b) with J_c_a, J_c_b.
@@ -169,7 +169,7 @@ struct Ops {
       }
     }
     if (jacobians) return py::make_tuple(out, Ja, Jb);
-    return std::move(out);
+    return out;
   }
 
   static py::object act(const py::object& g_, const py::object& p_, bool jacobians) {
@@ -193,7 +193,7 @@ struct Ops {
       }
     }
     if (jacobians) return py::make_tuple(out, Jg, Jp);
-    return std::move(out);
+    return out;
   }
 
   static py::object plus(const py::object& x_, const py::object& tau_, bool jacobians) {
@@ -214,7 +214,7 @@ struct Ops {
       }
     }
     if (jacobians) return py::make_tuple(out, Jx, Jt);
-    return std::move(out);
+    return out;
   }
 
   static py::object minus(const py::object& y_, const py::object& x_, bool jacobians) {
@@ -235,7 +235,7 @@ struct Ops {
       }
     }
     if (jacobians) return py::make_tuple(out, Jy, Jx);
-    return std::move(out);
+    return out;
   }
 
   static py::array_t<double> adjoint(const py::object& g_) {
