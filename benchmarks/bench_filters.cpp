@@ -72,9 +72,12 @@
 #include <string>
 #include <vector>
 
+#include "seed000_frames.hpp"
+
 namespace {
 
 constexpr std::size_t kFrames = 1024;
+static_assert(kFrames == posefuse_bench::kSeed000Frames);
 constexpr int kCheckFrames = 256;
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
@@ -123,29 +126,8 @@ const Intervals& kitti_intervals() {
   return out;
 }
 
-struct PlanarFrames {
-  std::vector<Eigen::Vector2d> u, z;
-};
-const PlanarFrames& planar_frames() {  // seed 000's inputs (as before this file's rewrite)
-  static const PlanarFrames f = []() __attribute__((noinline)) {
-    PlanarFrames out;
-    std::mt19937 rng(3);
-    std::normal_distribution<double> n(0.0, 0.3);
-    Eigen::Vector2d p(0, 0);
-    for (std::size_t k = 0; k < kFrames; ++k) {
-      const double sx = n(rng);
-      const double sy = n(rng);
-      const Eigen::Vector2d step(1.0 + sx, 0.2 * sy);
-      p += step;
-      out.u.push_back(step);
-      const double zx = n(rng);
-      const double zy = n(rng);
-      out.z.push_back(p + Eigen::Vector2d(zx, zy));
-    }
-    return out;
-  }();
-  return f;
-}
+using posefuse_bench::PlanarFrames;
+const PlanarFrames& planar_frames() { return posefuse_bench::seed000_frames(); }
 
 template <class A, class B>
 double rel_error(const A& a, const B& b) {

@@ -34,35 +34,17 @@
 #include <string>
 #include <vector>
 
+#include "seed000_frames.hpp"
+
 namespace {
 
 constexpr std::size_t kFrames = 1024;
+static_assert(kFrames == posefuse_bench::kSeed000Frames);
 constexpr double kSigmaProcess = 0.1, kSigmaMeasurement = 0.5;
 
-struct Frames {
-  std::vector<Eigen::Vector2d> u, z;
-};
-/// Seed 000's inputs, generated as bench_filters' planar_frames().
-const Frames& frames() {
-  static const Frames f = []() __attribute__((noinline)) {
-    Frames out;
-    std::mt19937 rng(3);
-    std::normal_distribution<double> n(0.0, 0.3);
-    Eigen::Vector2d p(0, 0);
-    for (std::size_t k = 0; k < kFrames; ++k) {
-      const double sx = n(rng);
-      const double sy = n(rng);
-      const Eigen::Vector2d step(1.0 + sx, 0.2 * sy);
-      p += step;
-      out.u.push_back(step);
-      const double zx = n(rng);
-      const double zy = n(rng);
-      out.z.push_back(p + Eigen::Vector2d(zx, zy));
-    }
-    return out;
-  }();
-  return f;
-}
+using Frames = posefuse_bench::PlanarFrames;
+/// Seed 000's inputs, the frames bench_filters times.
+const Frames& frames() { return posefuse_bench::seed000_frames(); }
 
 struct OpenCv {
   cv::KalmanFilter kf{2, 2, 2, CV_64F};
