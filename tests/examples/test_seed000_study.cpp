@@ -54,7 +54,13 @@ ControlCase make_control_case(double sigma_z, double sigma_u, std::uint64_t seed
     e.x() += sigma_z * normal(rng);
     e.z() += sigma_z * normal(rng);
     out.estimate.poses[k].translation() = scale * e;
-    if (k > 0) walk += Eigen::Vector3d(sigma_u * normal(rng), 0, sigma_u * normal(rng));
+    if (k > 0) {
+      // Two statements: the order of a constructor's arguments is unspecified,
+      // and the data must not depend on the compiler.
+      const double ux = sigma_u * normal(rng);
+      const double uz = sigma_u * normal(rng);
+      walk += Eigen::Vector3d(ux, 0, uz);
+    }
     out.control.poses[k].translation() += walk;
   }
   return out;
@@ -162,12 +168,34 @@ TEST_CASE("seed000 study: --tune recovers the generating noise and never reads t
   REQUIRE(tuned.array().size() == 3);  // cv, ctrv, control
 
   // The control filter's model is the generator's: R = 4e-4 m^2, Q = 0.25 m^2.
-  // Tolerance: within 30 % of each (1100 frames).
-  const Json* t = find_tuned(tuned, "control");
-  REQUIRE(t != nullptr);
-  CHECK((*t)["process"].number() == Approx(4e-4).epsilon(0.30));
-  CHECK((*t)["measurement"].number() == Approx(0.25).epsilon(0.30));
-  CHECK_FALSE((*t)["at_bound"].boolean());
+  // One realisation of 1100 frames fixes Q to a few per cent but R only to
+  // about 22 % (standard deviation of log R over seeds 12-19: R from 2.7e-4
+  // to 5.1e-4), so R is checked on the geometric mean over eight
+  // realisations (standard deviation about 8 %): within 20 %; Q within 30 %
+  // in each.
+  const auto control_r = [](const Json& tuned_list) {
+    const Json* t = find_tuned(tuned_list, "control");
+    REQUIRE(t != nullptr);
+    CHECK_FALSE((*t)["at_bound"].boolean());
+    CHECK((*t)["measurement"].number() == Approx(0.25).epsilon(0.30));
+    return (*t)["process"].number();
+  };
+  const auto tuned_control = [&](const std::string& args) {
+    const auto run = posefuse::test::run(exe, args, dir);
+    REQUIRE(run.status == 0);
+    return control_r(Json::parse(run.out)["estimates"][0]["tuned"]);
+  };
+  double sum_log_r = std::log(control_r(tuned));
+  for (std::uint64_t seed = 13; seed <= 19; ++seed) {
+    const ControlCase other_case = make_control_case(0.5, 0.02, seed);
+    const fs::path est_k = dir.path() / "est_k.txt", ctl_k = dir.path() / "ctl_k.txt";
+    posefuse::write_kitti(est_k, other_case.estimate);
+    posefuse::write_kitti(ctl_k, other_case.control);
+    INFO("seed " << seed);
+    sum_log_r += std::log(
+        tuned_control(" --estimate '" + est_k.string() + "' --control '" + ctl_k.string() + "' --tune --json"));
+  }
+  CHECK(std::exp(sum_log_r / 8.0) == Approx(4e-4).epsilon(0.20));
 
   // With either ground truth, aligned to it or not, the chosen values are
   // those of the run without ground truth, to the bit (with --align the
