@@ -6,7 +6,7 @@ the same definitions.
 
     PYTHONPATH=build /usr/bin/python3 python/bench/bench_eval.py [--poses 20000] [--repeat 5]
 
-The trajectory (generator `kitti_like_drive`): 10 Hz, speed 8 +- 2 m/s,
+The trajectory (generator `kitti_like`, python/tests/drives.py): 10 Hz, speed 8 +- 2 m/s,
 yaw rate 0.08 sin(0.02 t) + 0.03 sin(0.11 t) rad/s about the camera's y axis
 (KITTI camera frame, road plane x-z), 0.3 m height changes; the estimate
 composes the ground truth's relative motions with Gaussian noise
@@ -33,42 +33,8 @@ import numpy as np
 
 import posefuse
 
-
-def rotation(v):
-    """Rotation matrices (N, 3, 3) of rotation vectors (N, 3) (Rodrigues)."""
-    v = np.atleast_2d(v)
-    theta = np.linalg.norm(v, axis=1)
-    k = np.where(theta[:, None] > 0, v / np.where(theta > 0, theta, 1)[:, None], 0.0)
-    K = np.zeros((len(v), 3, 3))
-    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -k[:, 2], k[:, 1], -k[:, 0]
-    K[:, 1, 0], K[:, 2, 0], K[:, 2, 1] = k[:, 2], -k[:, 1], k[:, 0]
-    s, c = np.sin(theta)[:, None, None], np.cos(theta)[:, None, None]
-    return np.eye(3) + s * K + (1 - c) * (K @ K)
-
-
-def kitti_like_drive(n, seed=1, dt=0.1):
-    """(stamps, ground-truth poses (n, 4, 4), estimated poses (n, 4, 4)); see the file comment."""
-    rng = np.random.default_rng(seed)
-    t = dt * np.arange(n)
-    speed = 8.0 + 2.0 * np.sin(0.05 * t)
-    yaw = np.cumsum(0.08 * np.sin(0.02 * t) + 0.03 * np.sin(0.11 * t)) * dt
-    gt = np.tile(np.eye(4), (n, 1, 1))
-    gt[:, :3, :3] = rotation(np.c_[np.zeros(n), yaw, np.zeros(n)])
-    gt[:, :3, 3] = np.cumsum(gt[:, :3, 2] * (speed * dt)[:, None], axis=0)
-    gt[:, 1, 3] += 0.3 * np.sin(0.01 * t)
-    rel = np.linalg.inv(gt[:-1]) @ gt[1:]
-    noise = np.tile(np.eye(4), (n - 1, 1, 1))
-    noise[:, :3, :3] = rotation(rng.normal(0, 2e-4, (n - 1, 3)))
-    noise[:, :3, 3] = rng.normal(0, 0.01, (n - 1, 3))
-    steps = rel @ noise
-    est = np.empty_like(gt)
-    est[0] = gt[0]
-    for k in range(1, n):
-        est[k] = est[k - 1] @ steps[k - 1]
-    world = np.eye(4)
-    world[:3, :3] = rotation(np.array([[0.02, 0.3, -0.01]]))[0]
-    world[:3, 3] = [5.0, -1.0, 2.0]
-    return t, gt, world @ est
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests"))
+from drives import kitti_like  # noqa: E402  (the tests' generator)
 
 
 # ---- numpy reference (evo's definitions) -----------------------------------
@@ -172,7 +138,7 @@ def main():
     parser.add_argument("--poses", type=int, default=20000)
     parser.add_argument("--repeat", type=int, default=5)
     args = parser.parse_args()
-    _, gt, est = kitti_like_drive(args.poses)
+    _, gt, est = kitti_like(args.poses)
     with tempfile.TemporaryDirectory() as d:
         posefuse.write_trajectory(os.path.join(d, "gt.txt"), posefuse.Trajectory(np.arange(args.poses), gt), "kitti")
         posefuse.write_trajectory(os.path.join(d, "est.txt"), posefuse.Trajectory(np.arange(args.poses), est), "kitti")
