@@ -27,7 +27,8 @@ namespace {
 namespace py = pybind11;
 using namespace math;
 
-constexpr int kMaxKeyframes = 8;   // align_visual_inertial is compiled for 3 .. kMaxKeyframes keyframes
+constexpr int kMinKeyframes = 4;   // fewer: 6 (N-1) equations cannot fix 3N+4 unknowns
+constexpr int kMaxKeyframes = 8;   // align_visual_inertial is compiled for kMinKeyframes .. kMaxKeyframes keyframes
 
 /// Seconds -> ns, refusing what int64 cannot hold.
 std::int64_t to_ns(double t_s, const std::string& what) {
@@ -183,7 +184,7 @@ template <int N>
 py::object align_dispatch(int n, const Stack& T, const SE3d& T_b_c, const std::vector<Preintegration>& pre,
                           const VisualInertialAlignmentOptions& opt) {
   if constexpr (N > kMaxKeyframes) {
-    throw py::value_error("align_visual_inertial: " + std::to_string(n) + " keyframes; 3 to " +
+    throw py::value_error("align_visual_inertial: " + std::to_string(n) + " keyframes; " + std::to_string(kMinKeyframes) + " to " +
                           std::to_string(kMaxKeyframes) + " are supported");
   } else {
     if (n == N) return align_n<N>(T, T_b_c, pre, opt);
@@ -197,8 +198,8 @@ py::object align(const py::object& T_, const py::object& Tbc_, const std::vector
   const Stack T = stack_of(T_, {4, 4}, "align_visual_inertial: T_c0_c");
   if (T.lead.size() != 1) throw py::value_error("align_visual_inertial: T_c0_c: expected an array of shape (N, 4, 4), got " + shape_text(T.a));
   const int n = int(T.lead[0]);
-  if (n < 3 || n > kMaxKeyframes)
-    throw py::value_error("align_visual_inertial: " + std::to_string(n) + " keyframes; 3 to " +
+  if (n < kMinKeyframes || n > kMaxKeyframes)
+    throw py::value_error("align_visual_inertial: " + std::to_string(n) + " keyframes; " + std::to_string(kMinKeyframes) + " to " +
                           std::to_string(kMaxKeyframes) + " are supported");
   if (int(pre.size()) != n - 1)
     throw py::value_error("align_visual_inertial: " + std::to_string(n) + " keyframes need " + std::to_string(n - 1) +
@@ -210,7 +211,7 @@ py::object align(const py::object& T_, const py::object& Tbc_, const std::vector
   opt.max_gravity_norm_error = finite(max_gravity_norm_error, "align_visual_inertial: max_gravity_norm_error");
   if (refinement_iterations < 0) throw py::value_error("align_visual_inertial: refinement_iterations must be >= 0");
   opt.refinement_iterations = refinement_iterations;
-  return align_dispatch<3>(n, T, T_b_c, pre, opt);
+  return align_dispatch<kMinKeyframes>(n, T, T_b_c, pre, opt);
 }
 
 }  // namespace

@@ -129,7 +129,10 @@ template <int N>
 [[nodiscard]] VisualInertialAlignment<N> align_visual_inertial(
     const std::array<SE3d, N>& T_c0_c, const SE3d& T_b_c, std::span<Preintegration, N - 1> pre,
     const VisualInertialAlignmentOptions& options = {}) {
-  static_assert(N >= 3, "align_visual_inertial needs at least 3 keyframes");
+  // 6 (N − 1) equations in 3 N + 4 unknowns: at N = 3, 12 equations in 13
+  // unknowns, a system with a null space whatever the motion.
+  static_assert(N >= 4, "align_visual_inertial needs at least 4 keyframes: with 3, its 12 equations "
+                        "cannot determine the 13 unknowns (3 velocities, gravity, scale)");
   using M3 = Eigen::Matrix3d;
   constexpr int U = 3 * N + 4;        // unknowns [v_0..v_{N-1}, g, s]
   constexpr int Rows = 6 * (N - 1);
