@@ -5,11 +5,17 @@
 //   ./build-release/benchmarks/bench_filters --benchmark_repetitions=5 \
 //       --benchmark_report_aggregates_only=true --benchmark_enable_random_interleaving=true
 //
-// Every workload BM_<Workload> has three implementations of one EKF step
+// Every workload BM_<Workload> has these implementations of one EKF step
 // (predict + update) on the same inputs:
 //   BM_<Workload>/posefuse      posefuse::Ekf with the default options
 //                               (EkfOptions: Joseph form, NIS always, Jacobian
-//                               recorded, gain memo on) and the library's models
+//                               recorded, gain memo on) and the library's
+//                               models, one step(u, dt, z) call
+//   BM_<Workload>/posefuse_lean the same with LeanEkfOptions (standard form,
+//                               NIS only when gated, no Jacobian record; every
+//                               stored covariance still PSD-checked)
+//   BM_<Workload>/posefuse_separate  the default options, predict(u, dt) then
+//                               update<0>(z) (two calls, two covariance checks)
 //   BM_<Workload>/naive_fixed   the textbook step written directly with
 //                               fixed-size Eigen: Pbar = F P F^T + Q,
 //                               K = Pbar H^T (H Pbar H^T + R)^-1,
@@ -145,17 +151,23 @@ std::string disagreement() {
   typename W::Posefuse a;
   typename W::Dynamic b;
   typename W::PosefuseNoMemo c;
+  typename W::PosefuseLean d;
+  typename W::PosefuseSeparate e;
   for (int k = 0; k < kCheckFrames; ++k) {
     (void)ref.step(std::size_t(k));
     (void)a.step(std::size_t(k));
     (void)b.step(std::size_t(k));
     (void)c.step(std::size_t(k));
+    (void)d.step(std::size_t(k));
+    (void)e.step(std::size_t(k));
   }
   const VectorXd x = ref.state();
   if (!x.allFinite()) return "reference state not finite";
   if (!(W::difference(a.state(), x) <= 1e-9)) return "posefuse state differs from naive_fixed";
   if (!(W::difference(b.state(), x) <= 1e-9)) return "dynamic state differs from naive_fixed";
   if (!(W::difference(c.state(), x) <= 1e-9)) return "posefuse_nomemo state differs from naive_fixed";
+  if (!(W::difference(d.state(), x) <= 1e-9)) return "posefuse_lean state differs from naive_fixed";
+  if (!(W::difference(e.state(), x) <= 1e-9)) return "posefuse_separate state differs from naive_fixed";
   return {};
 }
 
@@ -212,19 +224,25 @@ struct Seed000 : Euclidean {
       return posefuse::PlanarDisplacement<double>::from_sigmas(0.1, 0.1);
     }
   }
-  template <class Options>
+  template <class Options, bool kFused = true>
   struct Filter {
     posefuse::BasicEkf<Options, Motion, posefuse::PositionFix<2>> ekf{
         motion(), posefuse::PositionFix<2>::isotropic(0.5)};
     Filter() { ekf.reset(planar_frames().z[0], Eigen::Matrix2d::Identity()); }
     posefuse::FilterStatus step(std::size_t k) {
       const PlanarFrames& f = planar_frames();
-      (void)ekf.predict(f.u[k], dt(k));
-      return ekf.template update<0>(f.z[k]).status;
+      if constexpr (kFused) {
+        return ekf.step(f.u[k], dt(k), f.z[k]).template update<0>().status;
+      } else {
+        (void)ekf.predict(f.u[k], dt(k));
+        return ekf.template update<0>(f.z[k]).status;
+      }
     }
     VectorXd state() const { return ekf.state(); }
   };
   using Posefuse = Filter<posefuse::EkfOptions>;
+  using PosefuseLean = Filter<posefuse::LeanEkfOptions>;
+  using PosefuseSeparate = Filter<posefuse::EkfOptions, false>;
   using PosefuseNoMemo = Filter<NoMemo>;
   struct Naive {
     Eigen::Vector2d mu = planar_frames().z[0];
@@ -296,18 +314,24 @@ struct ConstantVelocity : Euclidean {
     return x;
   }
   static Eigen::Vector2d z(std::size_t k) { return planar_frames().z[k] * 0.1; }
-  template <class Options>
+  template <class Options, bool kFused = true>
   struct Filter {
     posefuse::BasicEkf<Options, posefuse::ConstantVelocity2<double>, posefuse::PositionFix<4>> ekf{
         posefuse::ConstantVelocity2<double>(kQ), posefuse::PositionFix<4>::isotropic(kSigma)};
     Filter() { ekf.reset(x0(), Eigen::Matrix4d::Identity()); }
     posefuse::FilterStatus step(std::size_t k) {
-      (void)ekf.predict(posefuse::NoControl{}, dt(k));
-      return ekf.template update<0>(z(k)).status;
+      if constexpr (kFused) {
+        return ekf.step(posefuse::NoControl{}, dt(k), z(k)).template update<0>().status;
+      } else {
+        (void)ekf.predict(posefuse::NoControl{}, dt(k));
+        return ekf.template update<0>(z(k)).status;
+      }
     }
     VectorXd state() const { return ekf.state(); }
   };
   using Posefuse = Filter<posefuse::EkfOptions>;
+  using PosefuseLean = Filter<posefuse::LeanEkfOptions>;
+  using PosefuseSeparate = Filter<posefuse::EkfOptions, false>;
   using PosefuseNoMemo = Filter<NoMemo>;
   struct Naive {
     Eigen::Vector4d mu = x0();
@@ -402,18 +426,24 @@ struct UnicyclePoseFix {
     m.control_cov = control_cov();
     return m;
   }
-  template <class Options>
+  template <class Options, bool kFused = true>
   struct Filter {
     posefuse::BasicEkf<Options, posefuse::Unicycle<double>, posefuse::PlanarPoseFix<double>> ekf{
         motion(), posefuse::PlanarPoseFix<double>(pose_cov())};
     Filter() { ekf.reset(posefuse::PlanarPose<double>{}, Eigen::Matrix3d::Identity() * 0.1); }
     posefuse::FilterStatus step(std::size_t k) {
-      (void)ekf.predict(inputs().u[k], kDt);
-      return ekf.template update<0>(inputs().z[k]).status;
+      if constexpr (kFused) {
+        return ekf.step(inputs().u[k], kDt, inputs().z[k]).template update<0>().status;
+      } else {
+        (void)ekf.predict(inputs().u[k], kDt);
+        return ekf.template update<0>(inputs().z[k]).status;
+      }
     }
     VectorXd state() const { return ekf.state().vector(); }
   };
   using Posefuse = Filter<posefuse::EkfOptions>;
+  using PosefuseLean = Filter<posefuse::LeanEkfOptions>;
+  using PosefuseSeparate = Filter<posefuse::EkfOptions, false>;
   using PosefuseNoMemo = Filter<NoMemo>;
   struct Naive {
     Eigen::Vector3d mu = Eigen::Vector3d::Zero();
@@ -551,17 +581,23 @@ struct Pose15 : Euclidean {
   }
   static Eigen::Matrix<double, 15, 15> P0() { return Eigen::Matrix<double, 15, 15>::Identity(); }
   using Fix = posefuse::PositionFix<15, 6>;
-  template <class Options>
+  template <class Options, bool kFused = true>
   struct Filter {
     posefuse::BasicEkf<Options, Kinematic15, Fix> ekf{Kinematic15{}, Fix(R())};
     Filter() { ekf.reset(Kinematic15::State::Zero(), P0()); }
     posefuse::FilterStatus step(std::size_t k) {
-      (void)ekf.predict(posefuse::NoControl{}, kDt);
-      return ekf.template update<0>(measurements()[k]).status;
+      if constexpr (kFused) {
+        return ekf.step(posefuse::NoControl{}, kDt, measurements()[k]).template update<0>().status;
+      } else {
+        (void)ekf.predict(posefuse::NoControl{}, kDt);
+        return ekf.template update<0>(measurements()[k]).status;
+      }
     }
     VectorXd state() const { return ekf.state(); }
   };
   using Posefuse = Filter<posefuse::EkfOptions>;
+  using PosefuseLean = Filter<posefuse::LeanEkfOptions>;
+  using PosefuseSeparate = Filter<posefuse::EkfOptions, false>;
   using PosefuseNoMemo = Filter<NoMemo>;
   struct Naive {
     using M15 = Eigen::Matrix<double, 15, 15>;
@@ -640,18 +676,24 @@ struct CtrvEkf {
     d(2) = posefuse::angle_diff(a(2), b(2));
     return d.cwiseAbs().maxCoeff() / (1.0 + b.cwiseAbs().maxCoeff());
   }
-  template <class Options>
+  template <class Options, bool kFused = true>
   struct Filter {
     posefuse::BasicEkf<Options, posefuse::Ctrv<double>, posefuse::CtrvPositionFix<double>> ekf{
         motion(), posefuse::CtrvPositionFix<double>::isotropic(kSigma)};
     Filter() { ekf.reset(x0(), P0()); }
     posefuse::FilterStatus step(std::size_t k) {
-      (void)ekf.predict(posefuse::NoControl{}, kDt);
-      return ekf.template update<0>(measurements()[k]).status;
+      if constexpr (kFused) {
+        return ekf.step(posefuse::NoControl{}, kDt, measurements()[k]).template update<0>().status;
+      } else {
+        (void)ekf.predict(posefuse::NoControl{}, kDt);
+        return ekf.template update<0>(measurements()[k]).status;
+      }
     }
     VectorXd state() const { return ekf.state().vector(); }
   };
   using Posefuse = Filter<posefuse::EkfOptions>;
+  using PosefuseLean = Filter<posefuse::LeanEkfOptions>;
+  using PosefuseSeparate = Filter<posefuse::EkfOptions, false>;
   using PosefuseNoMemo = Filter<NoMemo>;
   /// The textbook step on the model's f, F and Q (heading wrapped after the update).
   struct Naive {
@@ -797,6 +839,9 @@ void BM_Rts(benchmark::State& st) {
 template <class W>
 void register_workload(const std::string& name, bool nomemo_row) {
   benchmark::RegisterBenchmark((name + "/posefuse").c_str(), BM_Step<W, typename W::Posefuse>);
+  benchmark::RegisterBenchmark((name + "/posefuse_lean").c_str(), BM_Step<W, typename W::PosefuseLean>);
+  benchmark::RegisterBenchmark((name + "/posefuse_separate").c_str(),
+                               BM_Step<W, typename W::PosefuseSeparate>);
   if (nomemo_row)
     benchmark::RegisterBenchmark((name + "/posefuse_nomemo").c_str(),
                                  BM_Step<W, typename W::PosefuseNoMemo>);

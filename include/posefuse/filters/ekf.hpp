@@ -21,8 +21,9 @@
 /// model's `noise()`, or `noise(x)` at the prior state when the model has it
 /// (state-dependent noise, core/concepts.hpp).
 ///
-/// **Solving with S** (core/spd_solver.hpp). For 1x1 and 2x2 innovations S
-/// is tested by Sylvester's criterion and inverted in closed form. Larger
+/// **Solving with S** (core/spd_solver.hpp). For 1x1, 2x2 and 3x3
+/// innovations S is tested by Sylvester's criterion and inverted in closed
+/// form. Larger
 /// ones are factorised, \f$ S = L D L^\top \f$, and K and the NIS
 /// \f$ r^\top S^{-1} r \f$ are computed by solving with L; no inverse is
 /// formed. Either way S counts as positive definite only when every pivot is
@@ -67,6 +68,7 @@
 #include <posefuse/filters/ekf_update_result.hpp>
 #include <tuple>
 #include <type_traits>
+#include <utility>
 
 namespace posefuse {
 
@@ -195,46 +197,61 @@ class BasicEkf {
   ///         or kNonFinite; the filter is unchanged unless kApplied
   [[nodiscard]] FilterStatus predict(const Control& u, Scalar dt) {
     if (!initialised_) return FilterStatus::kNotInitialised;
-    if (!std::isfinite(dt)) return FilterStatus::kNonFinite;
-    if (dt < Scalar(0)) return FilterStatus::kInvalidInput;
     StateType x_new = detail::zero_state<StateType>();
     Covariance P_new;
     [[maybe_unused]] Covariance F_new;  // recorded for the smoother (kRecordJacobian)
-    if constexpr (has_identity_jacobian_v<Motion>) {
-      x_new = motion_.predict(x_, u, dt);
-      // P is exactly symmetric, so P + Q is unless Q is not: mirror only then
-      // (the whole sum stays in vector registers otherwise).
-      P_new = P_ + Covariance(motion_.noise(x_, u, dt));
-      if (!exactly_symmetric(P_new)) [[unlikely]]
-        detail::mirror_lower(P_new);
-    } else if constexpr (HasLinearize<Motion>) {
-      // One model call (see HasLinearize, core/concepts.hpp).
-      const auto lin = motion_.linearize(x_, u, dt);
-      x_new = lin.state;
-      if constexpr (HasLinearizePropagate<Motion>) {
-        P_new = Covariance(lin.propagate(P_)) + Covariance(lin.noise);
-      } else {
-        P_new = sandwich(Covariance(lin.jacobian), Covariance(lin.noise));
-      }
-      if constexpr (Options::kRecordJacobian) F_new = lin.jacobian;
-    } else if constexpr (HasPropagate<Motion>) {
-      x_new = motion_.predict(x_, u, dt);
-      P_new = Covariance(motion_.propagate(P_, x_, u, dt)) + Covariance(motion_.noise(x_, u, dt));
-      if constexpr (Options::kRecordJacobian) F_new = motion_.jacobian(x_, u, dt);
-    } else {
-      x_new = motion_.predict(x_, u, dt);
-      const Covariance F = motion_.jacobian(x_, u, dt);
-      P_new = sandwich(F, Covariance(motion_.noise(x_, u, dt)));
-      if constexpr (Options::kRecordJacobian) F_new = F;
-    }
-    if (!detail::all_entries_finite(minus(x_new, x_))) return FilterStatus::kNonFinite;
-    if constexpr (!has_identity_jacobian_v<Motion>) detail::mirror_lower(P_new);
+    const FilterStatus s = predict_unchecked(u, dt, x_new, P_new, F_new);
+    if (s != FilterStatus::kApplied) return s;
     // Refuses NaN and Inf too; the finiteness pass runs only to name the failure.
     if (!detail::psd_accepts(P_new)) return detail::refused_covariance_status(P_new);
-    if constexpr (Options::kRecordJacobian && !has_identity_jacobian_v<Motion>) F_ = F_new;
-    x_ = x_new;
-    P_ = P_new;
+    commit(x_new, P_new, F_new);
     return FilterStatus::kApplied;
+  }
+
+  /// One whole step: predict(u, dt), then update<0>(z_0), ...,
+  /// update<N-1>(z_{N-1}) with the N held measurement models in order, with
+  /// the same statuses and, bit for bit, the same belief as those calls
+  /// (checked by tests/filters/test_ekf_step.cpp), but at one covariance
+  /// check less: the belief is carried between them in locals, and the
+  /// predicted covariance \f$ \bar P \f$ is not checked on its own when
+  /// the first update applies, because that update's checked posterior
+  /// certifies it:
+  ///
+  /// **Why the check of \f$ \bar P \f$ is implied.** An applied update has
+  /// S = H P̄ Hᵀ + R positive definite (SpdSolver) and R PSD (every model's
+  /// noise is validated), and forms, with the gain computed from P̄, the
+  /// posterior \f$ P^+ = \bar P - \bar P H^\top S^{-1} H \bar P \f$ (the
+  /// Joseph form equals it for that gain). (1) The congruence
+  /// \f$ \begin{bmatrix} I & -H \\ 0 & I \end{bmatrix}
+  /// \begin{bmatrix} S & H\bar P \\ \bar P H^\top & \bar P \end{bmatrix}
+  /// \begin{bmatrix} I & 0 \\ -H^\top & I \end{bmatrix} =
+  /// \begin{bmatrix} R & 0 \\ 0 & \bar P \end{bmatrix} \f$ and Haynsworth's
+  /// inertia additivity for the Schur complement of S give
+  /// \f$ \mathrm{In}(P^+) = \mathrm{In}(R) + \mathrm{In}(\bar P) -
+  /// \mathrm{In}(S) \f$: \f$ P^+ \f$ has exactly as many negative eigenvalues as
+  /// \f$ \bar P \f$. (2) Quantitatively, \f$ P^+ \preceq \bar P \f$ (the
+  /// subtracted term is PSD) and every variance shrinks, so for any w with
+  /// \f$ w^\top \bar P w < 0 \f$, \f$ w^\top P^+ w / w^\top D^+ w \le
+  /// w^\top \bar P w / w^\top \bar D w \f$ (D the diagonal): P̄'s most negative
+  /// direction is at least as negative in the scale-free form of \f$ P^+ \f$,
+  /// the form is_positive_semidefinite() judges. Hence a P̄ that the check
+  /// would refuse yields a posterior the check refuses, and an accepted
+  /// posterior stands for both checks. (In floating point, only a P̄ refused
+  /// by less than the update's own round-off, relative to the posterior's
+  /// variances, could pass; predict()'s decision there is itself a round-off
+  /// decision.) When the first update does not apply (gated, refused), P̄ is
+  /// checked on its own; if it is refused the step continues as the separate
+  /// calls do: the prediction is refused and the updates run on the belief
+  /// before the step.
+  /// @param[in] u  control input
+  /// @param[in] dt time step (s), finite and >= 0
+  /// @param[in] z  one measurement per held measurement model, in order
+  /// @return the prediction's status and every update's UpdateResult
+  [[nodiscard]] EkfStepResult<Sensors...> step(const Control& u, Scalar dt,
+                                               const typename Sensors::Measurement&... z)
+    requires(sizeof...(Sensors) > 0)
+  {
+    return step_impl(std::index_sequence_for<Sensors...>{}, u, dt, z...);
   }
 
   /// Update with the I-th measurement model of the filter, gated by its NIS
@@ -355,30 +372,126 @@ class BasicEkf {
   using GainMemo = detail::EkfGainMemo<H>;
   using NoGate = detail::NoGate;
 
+  /// The prediction of predict() into x_new, P_new (both triangles) and,
+  /// with kRecordJacobian, F_new, checked for everything but P_new's
+  /// definiteness. @return kApplied, kInvalidInput or kNonFinite
+  [[gnu::always_inline]] FilterStatus predict_unchecked(const Control& u, Scalar dt, StateType& x_new,
+                                                        Covariance& P_new,
+                                                        [[maybe_unused]] Covariance& F_new) const {
+    if (!std::isfinite(dt)) return FilterStatus::kNonFinite;
+    if (dt < Scalar(0)) return FilterStatus::kInvalidInput;
+    if constexpr (has_identity_jacobian_v<Motion>) {
+      x_new = motion_.predict(x_, u, dt);
+      // P is exactly symmetric, so P + Q is unless Q is not: mirror only then
+      // (the whole sum stays in vector registers otherwise).
+      P_new = P_ + Covariance(motion_.noise(x_, u, dt));
+      if (!exactly_symmetric(P_new)) [[unlikely]]
+        detail::mirror_lower(P_new);
+    } else if constexpr (HasLinearize<Motion>) {
+      // One model call (see HasLinearize, core/concepts.hpp).
+      const auto lin = motion_.linearize(x_, u, dt);
+      x_new = lin.state;
+      if constexpr (HasLinearizePropagate<Motion>) {
+        P_new = Covariance(lin.propagate(P_)) + Covariance(lin.noise);
+      } else {
+        P_new = sandwich(Covariance(lin.jacobian), Covariance(lin.noise));
+      }
+      if constexpr (Options::kRecordJacobian) F_new = lin.jacobian;
+    } else if constexpr (HasPropagate<Motion>) {
+      x_new = motion_.predict(x_, u, dt);
+      P_new = Covariance(motion_.propagate(P_, x_, u, dt)) + Covariance(motion_.noise(x_, u, dt));
+      if constexpr (Options::kRecordJacobian) F_new = motion_.jacobian(x_, u, dt);
+    } else {
+      x_new = motion_.predict(x_, u, dt);
+      const Covariance F = motion_.jacobian(x_, u, dt);
+      P_new = sandwich(F, Covariance(motion_.noise(x_, u, dt)));
+      if constexpr (Options::kRecordJacobian) F_new = F;
+    }
+    if (!detail::all_entries_finite(minus(x_new, x_))) return FilterStatus::kNonFinite;
+    if constexpr (!has_identity_jacobian_v<Motion>) detail::mirror_lower(P_new);
+    return FilterStatus::kApplied;
+  }
+  /// Stores an applied prediction (or a whole applied step).
+  [[gnu::always_inline]] void commit(const StateType& x, const Covariance& P,
+                                     [[maybe_unused]] const Covariance& F) {
+    if constexpr (Options::kRecordJacobian && !has_identity_jacobian_v<Motion>) F_ = F;
+    x_ = x;
+    P_ = P;
+  }
+
+  /// step() with the sensors' indices.
+  template <std::size_t... I>
+  [[gnu::always_inline]] EkfStepResult<Sensors...> step_impl(std::index_sequence<I...>, const Control& u,
+                                                             Scalar dt,
+                                                             const typename Sensors::Measurement&... z) {
+    EkfStepResult<Sensors...> out;
+    if (!initialised_) {
+      out.predict = FilterStatus::kNotInitialised;
+      ((std::get<I>(out.updates).status = FilterStatus::kNotInitialised), ...);
+      return out;
+    }
+    StateType x = detail::zero_state<StateType>();
+    Covariance P;
+    [[maybe_unused]] Covariance F;
+    out.predict = predict_unchecked(u, dt, x, P, F);
+    if (out.predict == FilterStatus::kApplied) {
+      bool unchecked = true;  // P still the predicted covariance, not checked
+      (step_update<I>(z, x, P, unchecked, out), ...);
+      if (out.predict == FilterStatus::kApplied) {
+        commit(x, P, F);
+        return out;
+      }
+    }
+    // The prediction was refused: the updates act on the belief before the step.
+    ((std::get<I>(out.updates) = update_held<I>(z, NoGate{})), ...);
+    return out;
+  }
+  /// The I-th update of step() on the carried belief (x, P); checks the
+  /// predicted covariance when the first update does not apply (step()).
+  template <std::size_t I>
+  [[gnu::always_inline]] void step_update(const typename SensorType<I>::Measurement& z, StateType& x,
+                                          Covariance& P, bool& unchecked, EkfStepResult<Sensors...>& out) {
+    if (out.predict != FilterStatus::kApplied) return;
+    auto& r = std::get<I>(out.updates);
+    r = update_held_on<I>(z, NoGate{}, x, P);
+    if (unchecked) {
+      unchecked = false;
+      if (r.status != FilterStatus::kApplied && !detail::psd_accepts(P))
+        out.predict = detail::refused_covariance_status(P);
+    }
+  }
+
   /// update<I>() with a gate (NoGate, a number or a functor) on top of gates_[I].
   template <std::size_t I, class Gate>
   [[gnu::always_inline]] UpdateResult<SensorType<I>> update_held(
       const typename SensorType<I>::Measurement& z, const Gate& gate) {
     using H = SensorType<I>;
     if (!initialised_) return detail::with_status(UpdateResult<H>{}, FilterStatus::kNotInitialised);
+    return update_held_on<I>(z, gate, x_, P_);
+  }
+  /// update_held() on the belief (x, P), changed only when the update applies.
+  template <std::size_t I, class Gate>
+  [[gnu::always_inline]] UpdateResult<SensorType<I>> update_held_on(
+      const typename SensorType<I>::Measurement& z, const Gate& gate, StateType& x, Covariance& P) {
+    using H = SensorType<I>;
     const H& sensor = std::get<I>(sensors_);
     if constexpr (Options::kGainMemo && is_time_invariant_v<H>) {
       // The gain half depends on P alone: reuse it while P repeats (a
       // converged, steady-state filter), bit for bit what it would compute.
       GainMemo<H>& memo = std::get<I>(memos_);
-      if (!detail::same_values(memo.P_in, P_)) {
+      if (!detail::same_values(memo.P_in, P)) {
         memo.valid = false;  // a new prior: record it, with no gain yet
-        memo.P_in = P_;
-        return detail::update_afresh<Options>(sensor, z, gates_[I], gate, x_, P_);
+        memo.P_in = P;
+        return detail::update_afresh<Options>(sensor, z, gates_[I], gate, x, P);
       }
       if (!memo.valid) {
-        const FilterStatus s = detail::compute_gain<Options>(sensor, x_, P_, memo.gain);
+        const FilterStatus s = detail::compute_gain<Options>(sensor, x, P, memo.gain);
         if (s != FilterStatus::kApplied) return detail::with_status(UpdateResult<H>{}, s);
         memo.valid = true;
       }
-      return detail::apply_gain<Options>(sensor, z, gates_[I], gate, memo.gain, x_, P_);
+      return detail::apply_gain<Options>(sensor, z, gates_[I], gate, memo.gain, x, P);
     } else {
-      return detail::update_afresh<Options>(sensor, z, gates_[I], gate, x_, P_);
+      return detail::update_afresh<Options>(sensor, z, gates_[I], gate, x, P);
     }
   }
 
@@ -412,5 +525,10 @@ class BasicEkf {
 /// Jacobians recorded, gain memo on. See BasicEkf.
 template <class Motion, class... Sensors>
 using Ekf = BasicEkf<EkfOptions, Motion, Sensors...>;
+
+/// The EKF with the lean options (LeanEkfOptions): standard form, NIS only
+/// when gated, no Jacobian record; the checks of every stored result kept.
+template <class Motion, class... Sensors>
+using LeanEkf = BasicEkf<LeanEkfOptions, Motion, Sensors...>;
 
 }  // namespace posefuse

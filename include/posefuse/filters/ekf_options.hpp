@@ -18,7 +18,7 @@ enum class CovarianceUpdate : std::uint8_t {
   /// PSD for any gain, so round-off in K does not make P indefinite. The
   /// default. Cost over kStandard: one Dim x Dim x M product more (one
   /// triangle of it), e.g. +20 multiplications for Dim 4, M 2. For a
-  /// selection H with one or two rows it is evaluated expanded, \f$ P - K H P
+  /// selection H with one to three rows it is evaluated expanded, \f$ P - K H P
   /// - P H^\top K^\top + K S K^\top \f$ (equal for a symmetric P; see
   /// detail::closed_form_selection_gain in filters/detail/ekf_update.hpp).
   kJoseph,
@@ -63,6 +63,27 @@ struct EkfOptions {
   /// Cost: one Dim x Dim comparison per update and, per model, a Dim x Dim
   /// copy of P whenever P changed; the gain is copied once per new steady state.
   static constexpr bool kGainMemo = true;
+};
+
+/// The lean option set: the cheapest step that still refuses what would
+/// corrupt the belief. `BasicEkf<LeanEkfOptions, Motion, Sensors...>` (or
+/// LeanEkf) against the defaults:
+///  * kStandard covariance form: \f$ (I - K H) \bar P \f$, exact only for the
+///    optimal gain, so round-off in K enters the covariance to first order
+///    (Joseph's form: second order). Kept: every stored covariance still
+///    passes is_positive_semidefinite(), so a step that round-off would
+///    leave indefinite is refused (kNotPositiveDefinite), never stored.
+///  * NIS only when gated (NisPolicy::kWhenGated): UpdateResult::nis is NaN
+///    unless a finite NIS gate or a gate functor taking the NIS needs it.
+///  * No Jacobian record: last_jacobian() does not compile (no RTS smoothing
+///    from this filter's own record).
+/// Kept as in EkfOptions: the steady-state gain memo, the finiteness checks
+/// of state and innovation, S's positive-definiteness test and the PSD
+/// check of every stored covariance.
+struct LeanEkfOptions : EkfOptions {
+  static constexpr CovarianceUpdate kCovarianceUpdate = CovarianceUpdate::kStandard;
+  static constexpr NisPolicy kNis = NisPolicy::kWhenGated;
+  static constexpr bool kRecordJacobian = false;
 };
 
 /// A type usable as BasicEkf's options (see EkfOptions).

@@ -1,12 +1,15 @@
 #pragma once
 /// @file
 /// What a Kalman update returns, UpdateResult (status, innovation, its
-/// covariance S and the NIS), and the gates an update accepts,
-/// InnovationGate: a NIS threshold or a functor of the innovation.
+/// covariance S and the NIS), what a whole step returns, EkfStepResult, and
+/// the gates an update accepts, InnovationGate: a NIS threshold or a
+/// functor of the innovation.
 
 #include <limits>
 #include <posefuse/core/concepts.hpp>
+#include <cstddef>
 #include <posefuse/core/status.hpp>
+#include <tuple>
 #include <type_traits>
 
 namespace posefuse {
@@ -25,6 +28,25 @@ struct UpdateResult {
 
   /// True when the update was applied.
   [[nodiscard]] explicit operator bool() const noexcept { return status == FilterStatus::kApplied; }
+};
+
+/// What BasicEkf::step() did: the prediction's status and, in order, the
+/// UpdateResult of each measurement model's update.
+template <MeasurementModel... Sensors>
+struct EkfStepResult {
+  FilterStatus predict = FilterStatus::kNonFinite;  ///< as predict() would return
+  std::tuple<UpdateResult<Sensors>...> updates;     ///< as update<I>() would return
+
+  /// The I-th update's result.
+  template <std::size_t I>
+  [[nodiscard]] const auto& update() const noexcept {
+    return std::get<I>(updates);
+  }
+  /// True when the prediction and every update were applied.
+  [[nodiscard]] explicit operator bool() const noexcept {
+    return predict == FilterStatus::kApplied &&
+           std::apply([](const auto&... r) { return (static_cast<bool>(r) && ...); }, updates);
+  }
 };
 
 /// A gate for updates with measurement model H: a NIS threshold (any

@@ -8,8 +8,9 @@
 ///    positive-definiteness test and solver (core/spd_solver.hpp),
 ///    \f$ K = P H^\top S^{-1} \f$ and the posterior covariance, kept in an
 ///    EkfGain. How it is computed depends on H's structure, known at compile
-///    time: a row selection with one or two rows (closed_form_selection_gain),
-///    a larger row selection, or a dense Jacobian (dense_gain).
+///    time: a row selection with one to three rows
+///    (closed_form_selection_gain), a larger row selection, or a dense
+///    Jacobian (dense_gain).
 /// 2. apply_gain(): the one tail: the innovation \f$ r = z \boxminus h(\bar
 ///    x) \f$, the NIS \f$ r^\top S^{-1} r \f$, the gates, and \f$ x \boxplus
 ///    K r \f$ with the posterior covariance, stored only if all of it passed.
@@ -43,11 +44,12 @@ template <class H, int Dim>
 inline constexpr bool is_row_selection_v =
     (has_identity_jacobian_v<H> && DimOf<typename H::Measurement> == Dim) || has_selection_v<H>;
 
-/// A row selection with one or two rows: S is inverted in closed form and
-/// the gain half runs on scalars (closed_form_selection_gain).
+/// A row selection with one to three rows (a position fix, a planar pose
+/// fix): S is inverted in closed form and the gain half runs on scalars
+/// (closed_form_selection_gain).
 template <class H, int Dim>
 inline constexpr bool is_closed_form_selection_v =
-    is_row_selection_v<H, Dim> && DimOf<typename H::Measurement> <= 2;
+    is_row_selection_v<H, Dim> && DimOf<typename H::Measurement> <= 3;
 
 /// The state components a row selection H picks, in measurement order: its
 /// `kSelection`, or 0, 1, ... for H = I.
@@ -178,7 +180,7 @@ struct EkfGainMemo {
   EkfGain<H> gain = EkfGain<H>::zero();
 };
 
-/// compute_gain() for a row selection H with one or two rows, on scalars
+/// compute_gain() for a row selection H with one to three rows, on scalars
 /// (kept in registers): S, its closed-form test and inverse (SpdSolver),
 /// then \f$ U = P H^\top \mathrm{adj}(S) \f$ and \f$ W = U S U^\top \f$,
 /// which do not wait for \f$ g = 1 / \det S \f$, so that the division is
@@ -196,7 +198,7 @@ template <class Options, class H>
   using Scalar = typename EkfGain<H>::Scalar;
   constexpr int Dim = EkfGain<H>::Dim;
   constexpr int M = EkfGain<H>::M;
-  static_assert(M == 1 || M == 2);
+  static_assert(M >= 1 && M <= 3);
   constexpr std::array<int, std::size_t(M)> sel = selected_components<H>();
   const auto R = measurement_noise(sensor, x);
   Scalar B[Dim][M];  // P H^T: the selected columns of P
@@ -213,9 +215,12 @@ template <class Options, class H>
   for (int i = 0; i < Dim; ++i) {
     if constexpr (M == 1) {
       U[i][0] = B[i][0];
-    } else {
+    } else if constexpr (M == 2) {
       U[i][0] = B[i][0] * S[1][1] - B[i][1] * S[1][0];
       U[i][1] = B[i][1] * S[0][0] - B[i][0] * S[0][1];
+    } else {
+      const auto& A = g.solver.adjugate();
+      for (int a = 0; a < 3; ++a) U[i][a] = B[i][0] * A(0, a) + B[i][1] * A(1, a) + B[i][2] * A(2, a);
     }
   }
   const Scalar rd = g.solver.recip_det();
@@ -393,13 +398,14 @@ template <class Options, class H, class Gate>
   if (!gate_accepts<H>(gate, out)) return out;
   out.status = FilterStatus::kNonFinite;
   TangentOf<StateType> dx;  // K r
-  if constexpr (EkfGain<H>::M <= 2) {
-    // Row by row on scalars (the sums Eigen's product forms for one or two
+  if constexpr (EkfGain<H>::M <= 3) {
+    // Row by row on scalars (the sums Eigen's product forms for up to three
     // columns): closed_form_selection_gain() writes K entry by entry, and
     // reading it back in pairs stalls store-to-load forwarding.
     for (int i = 0; i < EkfGain<H>::Dim; ++i) {
       ScalarOf<StateType> v = g.K(i, 0) * out.innovation(0);
-      if constexpr (EkfGain<H>::M == 2) v += g.K(i, 1) * out.innovation(1);
+      if constexpr (EkfGain<H>::M >= 2) v += g.K(i, 1) * out.innovation(1);
+      if constexpr (EkfGain<H>::M == 3) v += g.K(i, 2) * out.innovation(2);
       dx(i) = v;
     }
   } else {
