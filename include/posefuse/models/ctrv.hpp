@@ -137,19 +137,44 @@ class Ctrv {
     State state;      ///< \f$ f(x, \Delta t) \f$
     Matrix jacobian;  ///< \f$ J_{f,x} \f$
     Matrix noise;     ///< Q, as noise()
-    /// \f$ J P J^\top \f$ from the seven non-trivial entries of J: rows 0 and
-    /// 1 gain J(0|1, 2..4) times rows 2..4 and row 2 gains dt times row 4,
-    /// then the same on columns (see HasLinearizePropagate).
+    /// \f$ J P J^\top \f$ from the seven non-trivial entries of J (J = I
+    /// except \f$ J_{0,2..4} = a,\ J_{1,2..4} = b,\ J_{2,4} = dt \f$), in
+    /// closed form: the columns \f$ c_j = P J_j^\top \f$ for j = 0, 1, 2 (the
+    /// others are P's own), then row i of the result is \f$ J_i c_j \f$;
+    /// one triangle is computed (42 multiply-adds instead of the 250 of two
+    /// dense 5x5 products) and mirrored (see HasLinearizePropagate). P must
+    /// be symmetric, as every covariance is.
     [[nodiscard]] Matrix propagate(const Matrix& P) const noexcept {
       const Matrix& J = jacobian;
-      Matrix B = P;
-      B.row(0) += J(0, 2) * P.row(2) + J(0, 3) * P.row(3) + J(0, 4) * P.row(4);
-      B.row(1) += J(1, 2) * P.row(2) + J(1, 3) * P.row(3) + J(1, 4) * P.row(4);
-      B.row(2) += J(2, 4) * P.row(4);
-      Matrix out = B;
-      out.col(0) += J(0, 2) * B.col(2) + J(0, 3) * B.col(3) + J(0, 4) * B.col(4);
-      out.col(1) += J(1, 2) * B.col(2) + J(1, 3) * B.col(3) + J(1, 4) * B.col(4);
-      out.col(2) += J(2, 4) * B.col(4);
+      const T a2 = J(0, 2), a3 = J(0, 3), a4 = J(0, 4);
+      const T b2 = J(1, 2), b3 = J(1, 3), b4 = J(1, 4);
+      const T d = J(2, 4);
+      using V5 = Eigen::Matrix<T, 5, 1>;
+      using V4 = Eigen::Matrix<T, 4, 1>;
+      using V3 = Eigen::Matrix<T, 3, 1>;
+      // c_0 (all rows), c_1 (rows 1..4), c_2 (rows 2..4): what the lower triangle reads.
+      const V5 c0 = P.col(0) + a2 * P.col(2) + a3 * P.col(3) + a4 * P.col(4);
+      const V4 c1 = P.col(1).template tail<4>() + b2 * P.col(2).template tail<4>() +
+                    b3 * P.col(3).template tail<4>() + b4 * P.col(4).template tail<4>();
+      const V3 c2 = P.col(2).template tail<3>() + d * P.col(4).template tail<3>();
+      Matrix out;
+      out(0, 0) = c0(0) + a2 * c0(2) + a3 * c0(3) + a4 * c0(4);
+      out(1, 0) = c0(1) + b2 * c0(2) + b3 * c0(3) + b4 * c0(4);
+      out(2, 0) = c0(2) + d * c0(4);
+      out(3, 0) = c0(3);
+      out(4, 0) = c0(4);
+      out(1, 1) = c1(0) + b2 * c1(1) + b3 * c1(2) + b4 * c1(3);
+      out(2, 1) = c1(1) + d * c1(3);
+      out(3, 1) = c1(2);
+      out(4, 1) = c1(3);
+      out(2, 2) = c2(0) + d * c2(2);
+      out(3, 2) = c2(1);
+      out(4, 2) = c2(2);
+      out(3, 3) = P(3, 3);
+      out(4, 3) = P(4, 3);
+      out(4, 4) = P(4, 4);
+      for (int j = 0; j < 5; ++j)
+        for (int i = j + 1; i < 5; ++i) out(j, i) = out(i, j);
       return out;
     }
   };

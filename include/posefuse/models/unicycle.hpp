@@ -129,8 +129,7 @@ struct Unicycle {
   [[nodiscard]] Eigen::Matrix<T, 3, 3> noise(const State& x, const Control& u, T dt_s) const noexcept {
     Eigen::Matrix<T, 3, 2> Ju;
     (void)unicycle_step(x, u(0) * dt_s, u(1) * dt_s, method, nullptr, &Ju);
-    const Eigen::Matrix<T, 3, 3> Q = (dt_s * dt_s) * (Ju * control_cov * Ju.transpose());
-    return T(0.5) * (Q + Q.transpose());
+    return noise_of(Ju, dt_s);
   }
 
   /// predict(), jacobian() and noise() from one integration of the step
@@ -140,17 +139,24 @@ struct Unicycle {
     State state;                      ///< \f$ f(x, u, \Delta t) \f$
     Eigen::Matrix<T, 3, 3> jacobian;  ///< \f$ J_{f,x} = [1, 0, a; 0, 1, b; 0, 0, 1] \f$
     Eigen::Matrix<T, 3, 3> noise;     ///< process noise, as noise()
-    /// \f$ J_{f,x} P J_{f,x}^\top \f$ from the two non-trivial entries of the
-    /// Jacobian (rows, then columns, 0 and 1 gain a, b times row / column 2;
-    /// see HasLinearizePropagate).
+    /// \f$ J_{f,x} P J_{f,x}^\top \f$ from the two non-trivial entries a, b
+    /// of the Jacobian, in closed form: with \f$ p_i \f$ row i of P, rows 0
+    /// and 1 become \f$ p_0 + a p_2,\ p_1 + b p_2 \f$ and then the same on
+    /// columns; one triangle is computed (eight multiply-adds) and mirrored
+    /// (see HasLinearizePropagate). P must be symmetric, as every covariance
+    /// is; only its lower triangle is read.
     [[nodiscard]] Eigen::Matrix<T, 3, 3> propagate(const Eigen::Matrix<T, 3, 3>& P) const noexcept {
       const T a = jacobian(0, 2), b = jacobian(1, 2);
-      Eigen::Matrix<T, 3, 3> B = P;
-      B.row(0) += a * P.row(2);
-      B.row(1) += b * P.row(2);
-      Eigen::Matrix<T, 3, 3> out = B;
-      out.col(0) += a * B.col(2);
-      out.col(1) += b * B.col(2);
+      Eigen::Matrix<T, 3, 3> out;
+      out(2, 2) = P(2, 2);
+      out(2, 0) = P(2, 0) + a * P(2, 2);
+      out(2, 1) = P(2, 1) + b * P(2, 2);
+      out(0, 0) = (P(0, 0) + a * P(2, 0)) + a * out(2, 0);
+      out(1, 0) = (P(1, 0) + b * P(2, 0)) + a * out(2, 1);
+      out(1, 1) = (P(1, 1) + b * P(2, 1)) + b * out(2, 1);
+      out(0, 1) = out(1, 0);
+      out(0, 2) = out(2, 0);
+      out(1, 2) = out(2, 1);
       return out;
     }
   };
@@ -159,9 +165,31 @@ struct Unicycle {
     Linearization out;
     Eigen::Matrix<T, 3, 2> Ju;
     out.state = unicycle_step(x, u(0) * dt_s, u(1) * dt_s, method, &out.jacobian, &Ju);
-    const Eigen::Matrix<T, 3, 3> Q = (dt_s * dt_s) * (Ju * control_cov * Ju.transpose());
-    out.noise = T(0.5) * (Q + Q.transpose());
+    out.noise = noise_of(Ju, dt_s);
     return out;
+  }
+
+ private:
+  /// \f$ J_u (\Delta t^2 \Sigma) J_u^\top \f$, \f$ \Sigma \f$ = control_cov made
+  /// symmetric, in closed form from \f$ J_u \f$'s structure (row 2 is (0, 1)):
+  /// one triangle (six entries) computed and mirrored, so the result is
+  /// exactly symmetric.
+  [[nodiscard]] Eigen::Matrix<T, 3, 3> noise_of(const Eigen::Matrix<T, 3, 2>& Ju, T dt_s) const noexcept {
+    const T d2 = dt_s * dt_s;
+    const T s00 = d2 * control_cov(0, 0), s11 = d2 * control_cov(1, 1);
+    const T s01 = d2 * (T(0.5) * (control_cov(0, 1) + control_cov(1, 0)));
+    const T a0 = Ju(0, 0), b0 = Ju(0, 1), a1 = Ju(1, 0), b1 = Ju(1, 1);
+    // Rows 0 and 1 of J_u S: (a s00 + b s01, a s01 + b s11); row 2 is (s01, s11).
+    const T g00 = a0 * s00 + b0 * s01, g01 = a0 * s01 + b0 * s11;
+    const T g10 = a1 * s00 + b1 * s01, g11 = a1 * s01 + b1 * s11;
+    Eigen::Matrix<T, 3, 3> Q;
+    Q(0, 0) = g00 * a0 + g01 * b0;
+    Q(1, 0) = Q(0, 1) = g10 * a0 + g11 * b0;
+    Q(1, 1) = g10 * a1 + g11 * b1;
+    Q(2, 0) = Q(0, 2) = s01 * a0 + s11 * b0;
+    Q(2, 1) = Q(1, 2) = s01 * a1 + s11 * b1;
+    Q(2, 2) = s11;
+    return Q;
   }
 };
 
