@@ -52,16 +52,14 @@
 /// random walks add \f$ \sigma_b^2\,\delta t\,I \f$. The covariance is
 /// \f$ P' = F P F^\top + G Q G^\top \f$ from \f$ P = 0 \f$ (VINS-Mono eq 11).
 ///
-/// **Cost.** The update exploits the structure: internally the rotation
-/// error is the left perturbation in frame i, \f$ \theta = \Delta R\,\delta\phi \f$
-/// (so its transition is the identity and \f$ \partial\bar u/\partial\theta = -[\bar u]_\times \f$),
-/// only the non-zero 3x3 blocks of P are stored (the bias-bias blocks stay
-/// scalar × I, Cov(θ, b_a) stays 0), the noise term has a closed form, and
-/// the result is converted to δφ when read (covariance(), bias_jacobian()).
-/// Position and velocity rows are stacked as 6x3 blocks so that their
-/// products vectorise with SSE2 (no -march flag is assumed), products by
-/// \f$ U_{b_g} \f$ go through V, and \f$ U_{b_a}U_{b_a}^\top \f$, \f$ VV^\top \f$ have
-/// closed forms. The step carries `[[gnu::flatten]]` (g++ and clang; other
+/// **Cost.** The step does not form F and G: the integrator here advances
+/// ΔR, Δv, Δp, and detail::PreintegrationPropagation
+/// (inertial/detail/preintegration_propagation.hpp) moves the covariance and
+/// the bias Jacobians by their structure — only the non-zero 3x3 blocks,
+/// in internal coordinates whose transition is the identity, closed forms for
+/// the products with the step's rotation Jacobian and for the noise term —
+/// and converts them to the δφ form above when read (covariance(),
+/// bias_jacobian()). The step carries `[[gnu::flatten]]` (g++ and clang; other
 /// compilers ignore it): without it g++ leaves many of Eigen's small
 /// assignment kernels out of line and the step costs about 1.8x more.
 /// `DensePreintegration` in posefuse/testing/dense_preintegration.hpp forms the
@@ -100,6 +98,7 @@
 #include <posefuse/core/error.hpp>
 #include <posefuse/core/samples.hpp>
 #include <posefuse/core/time.hpp>
+#include <posefuse/inertial/detail/preintegration_propagation.hpp>
 #include <posefuse/inertial/detail/small_rotation.hpp>
 #include <posefuse/inertial/imu_types.hpp>
 #include <posefuse/lie/so3.hpp>
@@ -228,35 +227,13 @@ class Preintegration {
   /// the internal blocks on each call (a few hundred flops).
   template <class Lazy = void>
   [[nodiscard]] Covariance covariance() const {
-    const M3 Rt = R_.transpose();  // δφ = ΔR^T θ
-    Covariance P = Covariance::Zero();
-    P.block<3, 3>(0, 0) = C_.pp;
-    P.block<3, 3>(0, 3) = C_.qt.template topRows<3>() * R_;
-    P.block<3, 3>(0, 6) = C_.pv;
-    P.block<3, 3>(3, 3) = Rt * C_.tt * R_;
-    P.block<3, 3>(3, 6) = Rt * C_.qt.template bottomRows<3>().transpose();
-    P.block<3, 3>(6, 6) = C_.vv;
-    P.block<3, 3>(0, 9) = C_.qa.template topRows<3>();
-    P.block<3, 3>(0, 12) = C_.qg.template topRows<3>();
-    P.block<3, 3>(3, 12) = Rt * C_.tg;
-    P.block<3, 3>(6, 9) = C_.qa.template bottomRows<3>();
-    P.block<3, 3>(6, 12) = C_.qg.template bottomRows<3>();
-    P.block<3, 3>(9, 9).diagonal().setConstant(C_.da);
-    P.block<3, 3>(12, 12).diagonal().setConstant(C_.dg);
-    P.template triangularView<Eigen::StrictlyLower>() = P.transpose();
-    // The rotated diagonal block, symmetric to rounding: make it exact.
-    P.template block<3, 3>(3, 3).template triangularView<Eigen::StrictlyLower>() =
-        P.template block<3, 3>(3, 3).transpose();
-    return P;
+    return prop_.covariance(R_);
   }
   /// \f$ \partial[\Delta p, \Delta\phi, \Delta v] / \partial[b_a, b_g] \f$ at the
   /// linearisation bias (δφ the right perturbation of ΔR).
   template <class Lazy = void>
   [[nodiscard]] BiasJacobian bias_jacobian() const {
-    BiasJacobian J;
-    J << Jq_a_.template topRows<3>(), Jq_g_.template topRows<3>(), M3::Zero(),
-        R_.transpose() * Jt_g_, Jq_a_.template bottomRows<3>(), Jq_g_.template bottomRows<3>();
-    return J;
+    return prop_.bias_jacobian(R_);
   }
   /// The linearisation bias \f$ \bar b \f$.
   [[nodiscard]] const ImuBias& bias() const noexcept { return bias_; }
@@ -281,57 +258,22 @@ class Preintegration {
 
  private:
   using M3 = Eigen::Matrix3d;
-  using M63 = Eigen::Matrix<double, 6, 3>;
-  // Internally the rotation error is the left perturbation in frame i,
-  // ΔR_true = Exp(θ) ΔR, θ = ΔR δφ: its transition is the identity, the
-  // accelerometer term is a cross product, and F has no E^T blocks. The
-  // covariance is kept as its non-zero blocks, with p and v stacked as
-  // q = [p; v] where they share a column block (6x3: the products then
-  // vectorise with SSE2 packets of two). Cov(θ, b_a) stays 0, the bias-bias
-  // blocks are d_a I and d_g I; everything is converted to δφ when read.
-  struct Blocks {
-    M3 pp, pv, vv;   // Cov(q, q), upper blocks (pp, vv exactly symmetric)
-    M63 qt, qa, qg;  // Cov(q, θ), Cov(q, b_a), Cov(q, b_g)
-    M3 tt, tg;       // Cov(θ, θ) (exactly symmetric), Cov(θ, b_g)
-    double da, dg;   // bias variances (scalar × I)
-  };
 
   void clear_state() {
     delta_p_.setZero();
     delta_v_.setZero();
     delta_q_.setIdentity();
     R_.setIdentity();
-    Jq_a_.setZero();
-    Jq_g_.setZero();
-    Jt_g_.setZero();
-    for (M3* m : {&C_.pp, &C_.pv, &C_.vv, &C_.tt, &C_.tg}) m->setZero();
-    for (M63* m : {&C_.qt, &C_.qa, &C_.qg}) m->setZero();
-    C_.da = C_.dg = 0.0;
+    prop_.clear();
     dt_s_ = 0.0;
   }
 
   [[nodiscard]] SO3d rotation() const { return SO3d(delta_q_); }
 
-  /// Copies the strict upper triangle of a 3x3 block to the lower one.
-  static void mirror_upper(M3& S) noexcept {
-    S(1, 0) = S(0, 1);
-    S(2, 0) = S(0, 2);
-    S(2, 1) = S(1, 2);
-  }
-
-  /// One mid-point step (file comment) with the structured covariance and
-  /// Jacobian update, in the left form described at Blocks.
-  ///
-  /// With q = [p; v], the step is q' = A q + B z, θ' = θ + w, the biases
-  /// unchanged, where A = [I, dt I; 0, I], B = [h I; dt I] (h = dt²/2),
-  /// z = δu = -[u]x θ + U_a δb_a + U_g δb_g (+ noise) and w = -V δb_g (+ noise),
-  /// V = ΔR_{k+1} J_r(ω̄ dt) dt, U_a = -(ΔR_k + ΔR_{k+1})/2, U_g = [c_1]x V / 2.
-  /// P' follows from the cross-covariances of z and w with the old state;
-  /// every product by U_g goes through V (U_g M^T = -½ [c_1]x V M^T), and
-  /// U_a U_a^T and V V^T have closed forms (both depend only on y = ΔR_{k+1} θ_step).
+  /// One mid-point step (file comment); the covariance and the bias
+  /// Jacobians move in detail::PreintegrationPropagation, inlined here.
   [[gnu::flatten]] void integrate(const ImuSample& s0, const ImuSample& s1) {
     const double dt = seconds_between(s1.t_ns, s0.t_ns);
-    const double h = 0.5 * dt * dt;
     const Eigen::Vector3d a0 = s0.accel_mps2 - bias_.accel;
     const Eigen::Vector3d a1 = s1.accel_mps2 - bias_.accel;
     const Eigen::Vector3d w = 0.5 * (s0.gyro_radps + s1.gyro_radps) - bias_.gyro;
@@ -346,102 +288,12 @@ class Preintegration {
     // first-order renormalisation (3 - |q|²)/2 = 1/|q| + O(ε²) needs no sqrt or division.
     delta_q_.coeffs() *= 0.5 * (3.0 - delta_q_.squaredNorm());
     R_ = delta_q_.toRotationMatrix();
-    const Eigen::Vector3d c0 = R0 * a0, c1 = R_ * a1;
-    const Eigen::Vector3d u = 0.5 * (c0 + c1);
-    delta_p_ += dt * delta_v_ + h * u;
+    const Eigen::Vector3d c1 = R_ * a1;
+    const Eigen::Vector3d u = 0.5 * (R0 * a0 + c1);
+    delta_p_ += dt * delta_v_ + (0.5 * dt * dt) * u;
     delta_v_ += dt * u;
     dt_s_ += dt;
-
-    M3 Ua = R0 + R_;
-    Ua *= -0.5;
-    M3 V;
-    V.noalias() = R_ * Jr;
-    V *= dt;
-    const M3 Ug = -0.5 * detail::neg_skew_times(c1, V);  // ½[c1]x V
-
-    // Bias Jacobians (J_θa = 0): J_q' = A J_q + B U, J_θg' = J_θg - V.
-    const M3 Zg = detail::neg_skew_times(u, Jt_g_) + Ug;
-    Jq_a_.template topRows<3>() += dt * Jq_a_.template bottomRows<3>() + h * Ua;
-    Jq_a_.template bottomRows<3>() += dt * Ua;
-    Jq_g_.template topRows<3>() += dt * Jq_g_.template bottomRows<3>() + h * Zg;
-    Jq_g_.template bottomRows<3>() += dt * Zg;
-    Jt_g_ -= V;
-
-    // Closed forms, y = ΔR_{k+1} θ_step = ΔR_k θ_step:
-    // V V^T = dt² R1 J_r J_r^T R1^T = d0 I + d1 y y^T (J_r J_r^T = I + c [θ]x²,
-    // c = 2b - a² - b²|θ|², since [θ]x⁴ = -|θ|²[θ]x²);
-    // U_a U_a^T = ¼ R0 (2I + E + E^T) R0^T = (1 - ½a|θ|²) I + ½a y y^T;
-    // K = [c1]x V V^T = d0 [c1]x + d1 (c1 × y) y^T.
-    const Eigen::Vector3d y = R_ * theta;
-    const double t2 = theta.squaredNorm();
-    const double cj = 2.0 * jb - ja * ja - jb * jb * t2;
-    const double d0 = dt * dt * (1.0 - cj * y.squaredNorm()), d1 = dt * dt * cj;
-    const Eigen::Vector3d cy = c1.cross(y);
-    const M3 yy = y * y.transpose();
-    M3 K = d1 * (cy * y.transpose());
-    K(0, 1) -= d0 * c1.z();
-    K(1, 0) += d0 * c1.z();
-    K(0, 2) += d0 * c1.y();
-    K(2, 0) -= d0 * c1.y();
-    K(1, 2) -= d0 * c1.x();
-    K(2, 1) += d0 * c1.x();
-
-    // Cross-covariances of z and w with the old state.
-    Blocks& P = C_;
-    M63 Cqw;  // Cov(q, w) = -Cov(q, b_g) V^T
-    Cqw.noalias() = P.qg * V.transpose();
-    Cqw = -Cqw;
-    M3 Ctw;  // Cov(θ, w)
-    Ctw.noalias() = P.tg * V.transpose();
-    Ctw = -Ctw;
-    // Cov(q, z) = Cov(q, θ)[u]x + Cov(q, b_a) U_a^T + Cov(q, b_g) U_g^T, the last ½ Cov(q, w)[c1]x.
-    M63 Cqz = detail::times_skew<6>(P.qt, u) + 0.5 * detail::times_skew<6>(Cqw, c1);
-    Cqz.noalias() += P.qa * Ua.transpose();
-    // Cov(z, θ) = -[u]x Cov(θ, θ) + U_g Cov(b_g, θ), the last -½[c1]x Cov(w, θ).
-    const M3 Czt = detail::neg_skew_times(u, P.tt) + 0.5 * detail::neg_skew_times(c1, M3(Ctw.transpose()));
-    const M3 Cza = P.da * Ua;
-    const M3 Czg = detail::neg_skew_times(u, P.tg) + P.dg * Ug;
-    const M3 Czw = detail::neg_skew_times(u, Ctw) - (0.5 * P.dg) * K;
-    // Cov(z, z) = Cov(z, θ)[u]x + d_a U_a U_a^T + ½ Cov(z, w)[c1]x, plus the
-    // measurement noise (file comment), in the left form:
-    // Σθθ = ½c_g V V^T, Σuθ = -¼c_g K, Σuu = ½c_a I + c_g/8 K [c1]x^T.
-    const double two_over_dt = 2.0 / dt;
-    const double ca = two_over_dt * noise_.accel_noise_density * noise_.accel_noise_density;
-    const double cg = two_over_dt * noise_.gyro_noise_density * noise_.gyro_noise_density;
-    M3 Czz = detail::times_skew<3>(Czt, u) + detail::times_skew<3>(Czw, 0.5 * c1) +
-             (0.5 * P.da * ja) * yy + (cg / 8.0) * (d1 * (cy * cy.transpose()) - d0 * (c1 * c1.transpose()));
-    Czz.diagonal().array() +=
-        P.da * (1.0 - 0.5 * ja * t2) + 0.5 * ca + (cg / 8.0) * d0 * c1.squaredNorm();
-    mirror_upper(Czz);  // symmetric to rounding: make it exact
-    const M3 Sut = (-0.25 * cg) * K;
-
-    // Cov(q', q') = A Cov(q, q) A^T + M B^T + B M^T + B Czz B^T, M = A Cov(q, z).
-    const M3 Mp = Cqz.template topRows<3>() + dt * Cqz.template bottomRows<3>();
-    const M3 Mv = Cqz.template bottomRows<3>();
-    const M3 pvs = P.pv + P.pv.transpose();
-    P.pv += dt * P.vv + dt * Mp + h * Mv.transpose() + (h * dt) * Czz;
-    P.pp += dt * pvs + (dt * dt) * P.vv + h * (Mp + Mp.transpose()) + (h * h) * Czz;
-    P.vv += dt * (Mv + Mv.transpose()) + (dt * dt) * Czz;
-    mirror_upper(P.pp);
-    mirror_upper(P.vv);
-    // Cov(q', θ') = A (Cov(q, θ) + Cov(q, w)) + B (Cov(z, θ) + Cov(z, w) + Σuθ).
-    P.qt += Cqw;
-    const M3 Zt = Czt + Czw + Sut;
-    P.qt.template topRows<3>() += dt * P.qt.template bottomRows<3>() + h * Zt;
-    P.qt.template bottomRows<3>() += dt * Zt;
-    // Cov(q', b_a) = A Cov(q, b_a) + B d_a U_a; Cov(q', b_g) = A Cov(q, b_g) + B Cov(z, b_g).
-    P.qa.template topRows<3>() += dt * P.qa.template bottomRows<3>() + h * Cza;
-    P.qa.template bottomRows<3>() += dt * Cza;
-    P.qg.template topRows<3>() += dt * P.qg.template bottomRows<3>() + h * Czg;
-    P.qg.template bottomRows<3>() += dt * Czg;
-    // Cov(θ', θ') = Cov(θ, θ) + Cov(θ, w) + Cov(w, θ) + d_g V V^T + Σθθ; Cov(θ', b_g) = Cov(θ, b_g) - d_g V.
-    const double sv = P.dg + 0.5 * cg;
-    P.tt += Ctw + Ctw.transpose() + (sv * d1) * yy;
-    P.tt.diagonal().array() += sv * d0;
-    mirror_upper(P.tt);
-    P.tg -= P.dg * V;
-    P.da += noise_.accel_random_walk * noise_.accel_random_walk * dt;
-    P.dg += noise_.gyro_random_walk * noise_.gyro_random_walk * dt;
+    prop_.propagate({dt, R0, R_, Jr, ja, jb, theta, c1, u}, noise_);
   }
 
   ImuNoise noise_;
@@ -450,11 +302,9 @@ class Preintegration {
   std::vector<ImuSample> samples_;
   Eigen::Vector3d delta_p_, delta_v_;
   Eigen::Quaterniond delta_q_;
-  M3 R_;                 // ΔR as a matrix
-  M63 Jq_a_, Jq_g_;      // bias Jacobians of q = [Δp; Δv]
-  M3 Jt_g_;              // bias Jacobian of θ (left form)
-  Blocks C_;
-  double dt_s_ = 0.0;
+  M3 R_;  // ΔR as a matrix
+  detail::PreintegrationPropagation prop_;
+  double dt_s_ = 0.0;  // T
 };
 
 }  // namespace posefuse
