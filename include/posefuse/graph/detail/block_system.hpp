@@ -11,7 +11,8 @@
 ///
 /// BlockCholesky is the up-looking sparse Cholesky of Davis, "Direct Methods
 /// for Sparse Linear Systems", SIAM 2006, Ch. 4 (elimination tree, row
-/// patterns by `ereach`), run on B x B blocks: every scalar operation of the
+/// patterns by `ereach`, found once by the symbolic analysis and kept for
+/// every numeric factorisation), run on B x B blocks: every scalar operation of the
 /// textbook algorithm becomes a fixed-size B x B product, triangular solve
 /// or Cholesky, so the index work is B² times smaller than a scalar
 /// simplicial factorisation and the arithmetic is vectorised.
@@ -32,19 +33,45 @@ namespace posefuse::detail {
 /// -1 for a fixed end): position[i] = the block's column in the system.
 template <class Lazy = void>
 [[nodiscard]] std::vector<int> block_amd_order(int n, const std::vector<std::pair<int, int>>& pairs) {
-  std::vector<Eigen::Triplet<double>> trip;
-  trip.reserve(2 * pairs.size() + std::size_t(n));
-  for (int i = 0; i < n; ++i) trip.emplace_back(i, i, 1.0);
+  // The block graph's full symmetric pattern with its diagonal, sorted by
+  // row within each column, built directly (counting sort) as Eigen's
+  // minimum_degree_ordering wants it; parallel edges are merged.
+  std::vector<int> count(std::size_t(n) + 1, 0);
   for (const auto& e : pairs) {
     if (e.first < 0 || e.second < 0 || e.first == e.second) continue;
-    trip.emplace_back(e.first, e.second, 1.0);
-    trip.emplace_back(e.second, e.first, 1.0);
+    ++count[std::size_t(e.first) + 1];
+    ++count[std::size_t(e.second) + 1];
+  }
+  for (int i = 0; i < n; ++i) count[std::size_t(i) + 1] += count[std::size_t(i)] + 1;  // + the diagonal
+  std::vector<int> rows(static_cast<std::size_t>(count[std::size_t(n)]));
+  std::vector<int> fill(count.begin(), count.end() - 1);
+  for (int i = 0; i < n; ++i) rows[std::size_t(fill[std::size_t(i)]++)] = i;
+  for (const auto& e : pairs) {
+    if (e.first < 0 || e.second < 0 || e.first == e.second) continue;
+    rows[std::size_t(fill[std::size_t(e.first)]++)] = e.second;
+    rows[std::size_t(fill[std::size_t(e.second)]++)] = e.first;
+  }
+  std::vector<int> nnz_per_col(std::size_t(n), 0);
+  std::size_t total = 0;
+  for (int c = 0; c < n; ++c) {
+    const auto first = rows.begin() + count[std::size_t(c)], end = rows.begin() + count[std::size_t(c) + 1];
+    std::sort(first, end);
+    nnz_per_col[std::size_t(c)] = int(std::unique(first, end) - first);
+    total += std::size_t(nnz_per_col[std::size_t(c)]);
   }
   Eigen::SparseMatrix<double> A(n, n);
-  A.setFromTriplets(trip.begin(), trip.end());
+  A.resizeNonZeros(Eigen::Index(total));
+  int q = 0;
+  for (int c = 0; c < n; ++c) {
+    A.outerIndexPtr()[c] = q;
+    for (int t = 0; t < nnz_per_col[std::size_t(c)]; ++t) {
+      A.innerIndexPtr()[q] = rows[std::size_t(count[std::size_t(c)] + t)];
+      A.valuePtr()[q++] = 1.0;
+    }
+  }
+  A.outerIndexPtr()[n] = q;
   Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> Pinv;
-  Eigen::AMDOrdering<int> amd;
-  amd(A, Pinv);
+  Eigen::internal::minimum_degree_ordering(A, Pinv);  // what Eigen::AMDOrdering runs after symmetrising
   // Eigen's solvers factor P A P^T with P = Pinv^{-1}: old index i goes to P(i).
   const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> P = Pinv.inverse();
   std::vector<int> position(static_cast<std::size_t>(n));
@@ -211,7 +238,8 @@ class BlockCholesky {
   using Block = Eigen::Matrix<double, B, B>;
   using Vec = Eigen::Matrix<double, B, 1>;
 
-  /// Symbolic analysis: elimination tree and the pattern of L (Davis Alg. 4.1, 4.2).
+  /// Symbolic analysis: elimination tree, the pattern of L and its row
+  /// patterns (Davis Alg. 4.1, 4.2).
   void analyze(const BlockSystem<B>& sys) {
     n_ = sys.size();
     const std::size_t n = std::size_t(n_);
@@ -228,19 +256,33 @@ class BlockCholesky {
         }
       }
     }
-    // Column counts of L (strictly lower) from every row pattern.
+    // Every row pattern of L (topological order), kept for factorize(), and
+    // the column counts of L (strictly lower).
     Lp_.assign(n + 1, 0);
+    Rp_.assign(n + 1, 0);
+    Ri_.clear();
     stack_.resize(n);
     mark_.assign(n, -1);
     for (int k = 0; k < n_; ++k) {
       const int top = ereach(sys, k);
-      for (int t = top; t < n_; ++t) ++Lp_[std::size_t(stack_[std::size_t(t)]) + 1];
+      for (int t = top; t < n_; ++t) {
+        const int i = stack_[std::size_t(t)];
+        Ri_.push_back(i);
+        ++Lp_[std::size_t(i) + 1];
+      }
+      Rp_[std::size_t(k) + 1] = int(Ri_.size());
     }
     for (std::size_t c = 0; c < n; ++c) Lp_[c + 1] += Lp_[c];
+    // Row k's entries are appended to their columns in increasing k, so
+    // every column's rows are sorted.
     next_.resize(n);
+    std::copy(Lp_.begin(), Lp_.end() - 1, next_.begin());
+    Li_.resize(std::size_t(Lp_[n]));
+    for (int k = 0; k < n_; ++k)
+      for (int t = Rp_[std::size_t(k)]; t < Rp_[std::size_t(k) + 1]; ++t)
+        Li_[std::size_t(next_[std::size_t(Ri_[std::size_t(t)])]++)] = k;
     // L's blocks are written by factorize() before they are read; only the
     // accumulator x_ must start at zero (factorize() leaves it zero).
-    Li_.resize(std::size_t(Lp_[n]));
     Lx_.resize(std::size_t(Lp_[n]));
     Ldinv_.resize(n);
     x_.assign(n, Block::Zero());
@@ -252,21 +294,18 @@ class BlockCholesky {
     std::vector<int>& next = next_;  // next free slot of each column
     std::copy(Lp_.begin(), Lp_.end() - 1, next.begin());
     for (int k = 0; k < n_; ++k) {
-      const int top = ereach(sys, k);
       for (int p = sys.colptr[std::size_t(k)]; p < sys.colptr[std::size_t(k) + 1]; ++p)
         x_[std::size_t(sys.rowidx[std::size_t(p)])] = sys.off[std::size_t(p)];
       Block d = sys.diag[std::size_t(k)];
-      for (int t = top; t < n_; ++t) {
-        const int i = stack_[std::size_t(t)];
+      for (int t = Rp_[std::size_t(k)]; t < Rp_[std::size_t(k) + 1]; ++t) {
+        const int i = Ri_[std::size_t(t)];
         // y = L_ii^{-1} x_i; L(k, i) = y^T.
         const Block y = Ldinv_[std::size_t(i)] * x_[std::size_t(i)];
         x_[std::size_t(i)].setZero();
         for (int p = Lp_[std::size_t(i)]; p < next[std::size_t(i)]; ++p)
           x_[std::size_t(Li_[std::size_t(p)])].noalias() -= Lx_[std::size_t(p)] * y;
         d.noalias() -= y.transpose() * y;
-        const int p = next[std::size_t(i)]++;
-        Li_[std::size_t(p)] = k;
-        Lx_[std::size_t(p)] = y.transpose();
+        Lx_[std::size_t(next[std::size_t(i)]++)] = y.transpose();  // Li_ holds k there
       }
       if (!lower_cholesky_inverse(d, Ldinv_[std::size_t(k)])) {
         for (Block& m : x_) m.setZero();  // leave the accumulator clean for the next call
@@ -335,13 +374,15 @@ class BlockCholesky {
 
   /// Bytes of heap storage held (capacity, the factor and its work arrays).
   [[nodiscard]] std::size_t capacity_bytes() const noexcept {
-    const std::size_t ints = parent_.capacity() + Lp_.capacity() + Li_.capacity() + stack_.capacity() +
-                             mark_.capacity() + path_.capacity() + next_.capacity();
+    const std::size_t ints = parent_.capacity() + Lp_.capacity() + Li_.capacity() + Rp_.capacity() +
+                             Ri_.capacity() + stack_.capacity() + mark_.capacity() + path_.capacity() +
+                             next_.capacity();
     return sizeof(int) * ints + sizeof(Block) * (Lx_.capacity() + Ldinv_.capacity() + x_.capacity());
   }
 
  private:
   /// Pattern of row k of L in topological order: stack_[top .. n) (Davis Alg. 4.2).
+  /// Run once per row by analyze(), which keeps the patterns for factorize().
   int ereach(const BlockSystem<B>& sys, int k) {
     int top = n_;
     mark_[std::size_t(k)] = k;
@@ -363,6 +404,7 @@ class BlockCholesky {
   int n_ = 0;
   std::vector<int> parent_;  ///< elimination tree
   std::vector<int> Lp_, Li_;  ///< L's strictly lower blocks, column by column
+  std::vector<int> Rp_, Ri_;  ///< L's rows: row k's columns, in the order factorize() eliminates them
   std::vector<Block> Lx_;
   std::vector<Block> Ldinv_;  ///< inverses of the diagonal blocks' lower Cholesky factors
   std::vector<Block> x_;   ///< work: the column being eliminated

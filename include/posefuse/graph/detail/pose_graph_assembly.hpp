@@ -74,8 +74,11 @@ class PoseGraphAssembly {
     w_.c.resize(x.size());
     w_.s.resize(x.size());
     for (std::size_t a = 0; a < x.size(); ++a) {
-      w_.c[a] = std::cos(x[a](B - 1));
-      w_.s[a] = std::sin(x[a](B - 1));
+      // Both from one argument into locals: the compiler makes one sincos call.
+      const double yaw = x[a](B - 1);
+      const double c = std::cos(yaw), s = std::sin(yaw);
+      w_.c[a] = c;
+      w_.s[a] = s;
     }
   }
 
