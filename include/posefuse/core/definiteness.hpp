@@ -204,19 +204,22 @@ template <class Derived>
   }
 }
 
-/// Division-free first try of the fast path for sizes 3 and 4: Sylvester's
+/// Division-free first try of the fast path for sizes 3, 4 and 5: Sylvester's
 /// criterion with margins. True only when the reference (psd_reference) is
 /// certain to accept `m` as definite; false means "undecided".
 ///
 /// Checks: `m` exactly symmetric, every variance in \f$ [2^{-e}, 2^{e}] \f$
-/// (e = (max_exponent - 24) / 2n: double 125 at n = 4, float 13),
+/// (e = (max_exponent - 24) / 2n: double 125 at n = 4, 100 at n = 5; float
+/// 13 at n = 4, 10 at n = 5),
 /// \f$ m_{ij}^2 \le m_{ii} m_{jj} \f$, then the leading principal minors
 /// \f$ D_k \f$ (cofactor / Laplace expansion) against \f$ \theta_k \prod_{i<k}
 /// m_{ii} \f$ with \f$ \theta_k = 12 k\,k!\,\epsilon \f$ for k < n and
 /// \f$ \theta_n = 12 n\,n!\,\epsilon + 3\delta_n \f$ (\f$ \delta_n \f$ = psd_shift).
 ///
 /// Why: each expansion sums the k! Leibniz products, each after at most 3k
-/// roundings, so \f$ |\hat D_k - D_k| \le \gamma_{3k}\,\mathrm{per}|M_k| \le
+/// roundings (k - 1 multiplications and the additions of nested 2x2 and
+/// 3x3 minors: at most 10 for k = 4 and, with the ten-term sum of D_5
+/// added as a tree, 12 for k = 5), so \f$ |\hat D_k - D_k| \le \gamma_{3k}\,\mathrm{per}|M_k| \le
 /// \gamma_{3k}\,k! \prod m_{ii} (1 + k\epsilon) \f$ (the permanent bounded by
 /// the entry check). Hence every exact leading minor is positive (Sylvester:
 /// M, and its scale-free form C, are positive definite) and
@@ -230,14 +233,13 @@ template <class Derived>
 [[nodiscard]] bool psd_minors_accept(const Eigen::MatrixBase<Derived>& m) {
   using T = typename Derived::Scalar;
   constexpr int N = Derived::RowsAtCompileTime;
-  static_assert(N == 3 || N == 4);
+  static_assert(N >= 3 && N <= 5);
   constexpr T eps = std::numeric_limits<T>::epsilon();
-  constexpr T fact = N == 3 ? T(6) : T(24);
   constexpr T theta3 = T(12 * 3 * 6) * eps + (N == 3 ? T(3) * psd_shift<T>(3) : T(0));
-  constexpr T theta4 = T(12 * 4 * 24) * eps + T(3) * psd_shift<T>(4);
+  constexpr T theta4 = T(12 * 4 * 24) * eps + (N == 4 ? T(3) * psd_shift<T>(4) : T(0));
+  constexpr T theta5 = T(12 * 5 * 120) * eps + T(3) * psd_shift<T>(5);
   constexpr T theta2 = T(12 * 2 * 2) * eps;
-  (void)fact;
-  if constexpr (!(theta3 < T(0.5) && theta4 < T(0.5))) {
+  if constexpr (!(theta3 < T(0.5) && theta4 < T(0.5) && theta5 < T(0.5))) {
     return false;
   } else {
     // 2^-e and 2^e with e = (max_exponent - 24) / (2N): every product of
@@ -285,7 +287,30 @@ template <class Derived>
       const T n02 = a[2][0] * a[3][2] - a[2][2] * a[3][0];
       const T n01 = a[2][0] * a[3][1] - a[2][1] * a[3][0];
       const T d4 = m01 * n23 - m02 * n13 + m03 * n12 + m12 * n03 - m13 * n02 + m23 * n01;
-      return d4 >= theta4 * (p3 * a[3][3]);
+      const T p4 = p3 * a[3][3];
+      if constexpr (N == 4) {
+        return d4 >= theta4 * p4;
+      } else {
+        if (!(d4 >= theta4 * p4)) return false;
+        // D_5 by Laplace along rows 0, 1: the 2x2 minors m_ab of rows 0, 1
+        // times the complementary 3x3 minors t_cde of rows 2, 3, 4 (each
+        // along row 2, with the 2x2 minors q_ab of rows 3, 4).
+        const T m04 = a[0][0] * a[1][4] - a[0][4] * a[1][0];
+        const T m14 = a[0][1] * a[1][4] - a[0][4] * a[1][1];
+        const T m24 = a[0][2] * a[1][4] - a[0][4] * a[1][2];
+        const T m34 = a[0][3] * a[1][4] - a[0][4] * a[1][3];
+        T q[5][5];
+        for (int i = 0; i < 5; ++i)
+          for (int j = i + 1; j < 5; ++j) q[i][j] = a[3][i] * a[4][j] - a[3][j] * a[4][i];
+        const auto t = [&a, &q](int i, int j, int k) {  // rows 2, 3, 4; columns i < j < k
+          return a[2][i] * q[j][k] - a[2][j] * q[i][k] + a[2][k] * q[i][j];
+        };
+        // The sign of m_ab t_cde is that of the permutation (a b c d e).
+        const T d5 = ((m01 * t(2, 3, 4) - m02 * t(1, 3, 4)) + (m03 * t(1, 2, 4) - m04 * t(1, 2, 3))) +
+                     ((m12 * t(0, 3, 4) - m13 * t(0, 2, 4)) + (m14 * t(0, 2, 3) + m23 * t(0, 1, 4))) +
+                     (m34 * t(0, 1, 2) - m24 * t(0, 1, 3));
+        return d5 >= theta5 * (p4 * a[4][4]);
+      }
     }
   }
 }
@@ -295,7 +320,7 @@ template <class Derived>
 /// the reference test (psd_reference) is certain to accept `m` as positive
 /// definite; false means "undecided", never "indefinite".
 ///
-/// Sizes above 6 take psd_shifted_ldlt_accepts; sizes 3 and 4 first try
+/// Sizes above 6 take psd_shifted_ldlt_accepts; sizes 3 to 5 first try
 /// psd_minors_accept (no division). For fixed sizes 1..6: `m` exactly symmetric, every diagonal entry in
 /// [sqrt(min) / eps, sqrt(max) * eps] (no overflow or underflow below), then
 /// an LDLT of `m` in its given order, without pivoting, square roots or any
@@ -347,7 +372,7 @@ template <class Derived>
           return false;
         return m(1, 0) * m(1, 0) <= (T(1) - beta) * (m(0, 0) * m(1, 1));
       }
-      if constexpr (N == 3 || N == 4) {
+      if constexpr (N >= 3 && N <= 5) {
         if (psd_minors_accept(m)) return true;  // else the LDLT below decides
       }
       constexpr T l2 = T(kPsdFastMaxMultiplier) * T(kPsdFastMaxMultiplier);
