@@ -61,7 +61,7 @@
 /// and converts them to the δφ form above when read (covariance(),
 /// bias_jacobian()). The step carries `[[gnu::flatten]]` (g++ and clang; other
 /// compilers ignore it): without it g++ leaves many of Eigen's small
-/// assignment kernels out of line and the step costs about 1.8x more.
+/// assignment kernels out of line and the step costs about 1.5x more.
 /// `DensePreintegration` in posefuse/testing/dense_preintegration.hpp forms the
 /// 15x15 F and 15x18 G in the δφ form and multiplies them (VINS-Mono's way);
 /// a test checks both agree to 1e-12.
