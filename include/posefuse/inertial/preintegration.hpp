@@ -304,7 +304,7 @@ class Preintegration {
   Eigen::Quaterniond delta_q_;
   M3 R_;  // ΔR as a matrix
   detail::PreintegrationPropagation prop_;
-  double dt_s_ = 0.0;  // T
+  double dt_s_ = 0.0;  // Δt_ij (s)
 };
 
 }  // namespace posefuse

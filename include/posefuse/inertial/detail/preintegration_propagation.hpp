@@ -167,9 +167,9 @@ class PreintegrationPropagation {
   }
 
   /// The covariance over [δp, δφ, δv, δb_a, δb_g] (δφ the right perturbation),
-  /// exactly symmetric, given ΔR and the integrated time T.
+  /// exactly symmetric, given ΔR (p = r + τ v with the τ held here).
   [[nodiscard]] Covariance covariance(const M3& R) const {
-    const double T = tau_;
+    const double T = tau_;  // p = r + T v
     const M3 Rt = R.transpose();
     const auto p_rows = [T](const M63& X) { return M3(X.topRows<3>() + T * X.bottomRows<3>()); };
     Covariance P = Covariance::Zero();
@@ -193,9 +193,9 @@ class PreintegrationPropagation {
   }
 
   /// \f$ \partial[\Delta p, \Delta\phi, \Delta v] / \partial[b_a, b_g] \f$ (δφ the right
-  /// perturbation), given ΔR and the integrated time T.
+  /// perturbation), given ΔR (p = r + τ v).
   [[nodiscard]] BiasJacobian bias_jacobian(const M3& R) const {
-    const double T = tau_;
+    const double T = tau_;  // p = r + T v
     BiasJacobian J;
     J << Jq_a_.topRows<3>() + T * Jq_a_.bottomRows<3>(), Jq_g_.topRows<3>() + T * Jq_g_.bottomRows<3>(),
         M3::Zero(), R.transpose() * Jt_g_, Jq_a_.bottomRows<3>(), Jq_g_.bottomRows<3>();
@@ -205,7 +205,7 @@ class PreintegrationPropagation {
  private:
   /// Moves the reference time to now (τ = 0): r becomes Δp.
   [[gnu::noinline]] void rebase() noexcept {
-    const double T = tau_;
+    const double T = tau_;  // p = r + T v
     rr_ += T * (rv_ + rv_.transpose()) + (T * T) * vv_;
     mirror_upper(rr_);
     rv_ += T * vv_;
@@ -236,7 +236,7 @@ class PreintegrationPropagation {
   M3 tt_, tg_;           // Cov(θ, θ) (exactly symmetric), Cov(θ, b_g)
   double da_ = 0, dg_ = 0;  // bias variances (scalar × I)
   double tau_ = 0;          // τ: r = Δp - τ Δv
-  static constexpr double kRebaseS = 0.25;
+  static constexpr double kRebaseS = 0.25;  // largest τ (s) before rebase()
   M63 Jq_a_, Jq_g_;      // bias Jacobians of q
   M3 Jt_g_;              // bias Jacobian of θ (J_θa = 0)
 };
