@@ -23,11 +23,17 @@
 //                                After other rows in the same process, glibc's
 //                                adaptive heap thresholds keep freed memory
 //                                and the two rows take the same time.
+//   BM_PoseGraph4Dof/posefuse_rotation_first/N  the same after
+//                                initialize_rotation_first() (the start is
+//                                inside the timing)
 //   BM_PoseGraph4Dof/ceres/N     build a ceres::Problem + Solve (only when
 //                                Ceres is found): the same residual with
 //                                automatic differentiation, one [x y z yaw]
 //                                block per pose, LM, SPARSE_NORMAL_CHOLESKY,
 //                                function tolerance 1e-10, one thread
+//   BM_PoseGraph4Dof/ceres_rotation_first/N  the same Ceres solve started
+//                                from posefuse's rotation-first poses
+//                                (computed once, outside the timing)
 //
 //   BM_G2o/posefuse/G            the real planar g2o file G (manhattan, mit) end
 //                                to end from its parsed contents: build the
@@ -109,6 +115,8 @@
 #ifdef POSEFUSE_HAVE_CERES
 #include <ceres/ceres.h>
 #include <ceres/manifold.h>
+
+#include "ceres_pose_graph_4dof.hpp"
 #endif
 
 namespace {
@@ -134,12 +142,13 @@ PoseGraphWorkspace& program_workspace() {
   return workspace;
 }
 
-void run_posefuse(benchmark::State& state, bool held_workspace) {
+void run_posefuse(benchmark::State& state, bool held_workspace, bool rotation_first = false) {
   const sim::PoseGraphProblem& pr = problem(static_cast<int>(state.range(0)));
   PoseGraphWorkspace& workspace = program_workspace();
   PoseGraphSummary s;
   for (auto _ : state) {
     PoseGraph4Dof g = sim::to_pose_graph(pr);
+    if (rotation_first) g.initialize_rotation_first(workspace);
     s = held_workspace ? g.optimize({}, workspace) : g.optimize();
     benchmark::DoNotOptimize(s);
   }
@@ -150,6 +159,11 @@ void BM_PoseGraph4Dof_posefuse(benchmark::State& state) { run_posefuse(state, tr
 void BM_PoseGraph4Dof_posefuse_own_workspace(benchmark::State& state) { run_posefuse(state, false); }
 BENCHMARK(BM_PoseGraph4Dof_posefuse)
     ->Name("BM_PoseGraph4Dof/posefuse")
+    ->Arg(1000)->Arg(10000)->Arg(100000)
+    ->Unit(benchmark::kMillisecond);
+void BM_PoseGraph4Dof_posefuse_rotation_first(benchmark::State& state) { run_posefuse(state, true, true); }
+BENCHMARK(BM_PoseGraph4Dof_posefuse_rotation_first)
+    ->Name("BM_PoseGraph4Dof/posefuse_rotation_first")
     ->Arg(1000)->Arg(10000)->Arg(100000)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PoseGraph4Dof_posefuse_own_workspace)
@@ -300,63 +314,9 @@ BENCHMARK(BM_G2o3d_posefuse_chordal)->Name("BM_G2o3d/posefuse_chordal")->Unit(be
 
 #ifdef POSEFUSE_HAVE_CERES
 
-/// Angle wrapped to [-π, π) for Ceres's Jets (Ceres's pose_graph_2d
-/// normalize_angle idea, written here).
-template <class T>
-T wrap(const T& a) {
-  const T two_pi(2.0 * std::numbers::pi);
-  return a - two_pi * ceres::floor((a + T(std::numbers::pi)) / two_pi);
-}
-
-/// The standard 4-DoF residual (VINS-Mono's four-DoF error with g2o's
-/// measurement-frame translation error), whitened by the information's
-/// upper Cholesky factor.
-struct FourDofError {
-  Eigen::Matrix3d Qi_t;
-  Eigen::Vector3d dp;
-  double dyaw;
-  Eigen::Matrix4d sqrt_info;
-
-  template <class T>
-  bool operator()(const T* xi, const T* xj, T* residual) const {
-    const T d0 = xj[0] - xi[0], d1 = xj[1] - xi[1], d2 = xj[2] - xi[2];
-    const T ci = ceres::cos(xi[3]), si = ceres::sin(xi[3]);
-    // w = Rz(yaw_i)^T d
-    const T w0 = ci * d0 + si * d1, w1 = -si * d0 + ci * d1, w2 = d2;
-    T u[3];
-    for (int r = 0; r < 3; ++r) u[r] = T(Qi_t(r, 0)) * w0 + T(Qi_t(r, 1)) * w1 + T(Qi_t(r, 2)) * w2 - T(dp(r));
-    const double cm = std::cos(dyaw), sm = std::sin(dyaw);
-    T e[4];
-    e[0] = cm * u[0] + sm * u[1];
-    e[1] = -sm * u[0] + cm * u[1];
-    e[2] = u[2];
-    e[3] = wrap(xj[3] - xi[3] - T(dyaw));
-    for (int r = 0; r < 4; ++r) {
-      residual[r] = T(0);
-      for (int c = r; c < 4; ++c) residual[r] += T(sqrt_info(r, c)) * e[c];
-    }
-    return true;
-  }
-};
-
-/// What both Ceres benchmarks report of a solve.
-struct CeresRun {
-  double chi2;     ///< g2o's chi² (twice Ceres's cost)
-  int iterations;  ///< LM iterations (Ceres counts iteration 0)
-};
-
-/// The Ceres settings of every comparison: sparse normal Cholesky, one
-/// thread, LM with function tolerance 1e-10, at most 100 iterations.
-CeresRun solve_with_ceres(ceres::Problem& problem) {
-  ceres::Solver::Options o;
-  o.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-  o.max_num_iterations = 100;
-  o.function_tolerance = 1e-10;
-  o.num_threads = 1;
-  ceres::Solver::Summary summary;
-  ceres::Solve(o, &problem, &summary);
-  return {2.0 * summary.final_cost, static_cast<int>(summary.iterations.size()) - 1};
-}
+using bench::CeresRun;
+using bench::solve_with_ceres;
+using bench::wrap;
 
 /// The counters and label of a Ceres row; the label warns when
 /// OMP_THREAD_LIMIT is not 1 (CHOLMOD would start threads).
@@ -371,30 +331,45 @@ void report_ceres(benchmark::State& state, const CeresRun& run, std::string labe
 
 void BM_PoseGraph4Dof_ceres(benchmark::State& state) {
   const sim::PoseGraphProblem& pr = problem(static_cast<int>(state.range(0)));
-  double chi2 = 0;
-  int iterations = 0;
+  CeresRun run{};
   for (auto _ : state) {
-    std::vector<std::array<double, 4>> x(pr.initial.size());
-    for (std::size_t k = 0; k < x.size(); ++k)
-      x[k] = {pr.initial[k].p.x(), pr.initial[k].p.y(), pr.initial[k].p.z(), pr.initial[k].yaw};
-    ceres::Problem problem;
-    for (const Edge4Dof& e : pr.edges) {
-      const Pose4Dof& a = pr.initial[std::size_t(e.from)];
-      FourDofError f{rotation_from_euler_zyx(EulerZYX<double>{a.roll, a.pitch, 0.0}).transpose(), e.dp, e.dyaw,
-                     e.information.llt().matrixU()};
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<FourDofError, 4, 4, 4>(new FourDofError(f)),
-                               nullptr, x[std::size_t(e.from)].data(), x[std::size_t(e.to)].data());
-    }
-    problem.SetParameterBlockConstant(x[0].data());
-    const CeresRun run = solve_with_ceres(problem);
-    chi2 = run.chi2;
-    iterations = run.iterations;
+    std::vector<std::array<double, 4>> x = bench::ceres_blocks_4dof(pr.initial);
+    run = bench::solve_4dof_with_ceres(pr.edges, pr.initial, x);
     benchmark::DoNotOptimize(x.data());
   }
-  report_ceres(state, {chi2, iterations}, "");
+  report_ceres(state, run, "");
 }
 BENCHMARK(BM_PoseGraph4Dof_ceres)
     ->Name("BM_PoseGraph4Dof/ceres")
+    ->Arg(1000)->Arg(10000)->Arg(100000)
+    ->Unit(benchmark::kMillisecond);
+
+/// posefuse's rotation-first poses of simulated problem n (computed once).
+const std::vector<Pose4Dof>& rotation_first_poses(int n) {
+  static std::map<int, std::vector<Pose4Dof>> cache;
+  auto it = cache.find(n);
+  if (it == cache.end()) {
+    PoseGraph4Dof g = sim::to_pose_graph(problem(n));
+    g.initialize_rotation_first();
+    it = cache.emplace(n, g.poses()).first;
+  }
+  return it->second;
+}
+
+void BM_PoseGraph4Dof_ceres_rotation_first(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const sim::PoseGraphProblem& pr = problem(n);
+  const std::vector<Pose4Dof>& start = rotation_first_poses(n);
+  CeresRun run{};
+  for (auto _ : state) {
+    std::vector<std::array<double, 4>> x = bench::ceres_blocks_4dof(start);
+    run = bench::solve_4dof_with_ceres(pr.edges, pr.initial, x);
+    benchmark::DoNotOptimize(x.data());
+  }
+  report_ceres(state, run, "");
+}
+BENCHMARK(BM_PoseGraph4Dof_ceres_rotation_first)
+    ->Name("BM_PoseGraph4Dof/ceres_rotation_first")
     ->Arg(1000)->Arg(10000)->Arg(100000)
     ->Unit(benchmark::kMillisecond);
 
