@@ -66,8 +66,8 @@ struct Case {
   double dt;
 };
 
-/// The sinc series switch of detail::sinc_and_derivative, |w dt / 2| = eps^(1/8).
-double series_switch() { return std::sqrt(std::sqrt(std::sqrt(std::numeric_limits<double>::epsilon()))); }
+/// The sinc series switch of detail::sinc_and_derivative, |w dt / 2| = kSincSeriesLimit.
+double series_switch() { return posefuse::detail::kSincSeriesLimit<double>; }
 
 std::vector<Case> cases() {
   std::vector<Case> out;

@@ -17,8 +17,9 @@
 /// + a)) \f$ for \f$ \omega \ne 0 \f$ and the straight line \f$ p' = p + v\Delta t
 /// (\cos\theta, \sin\theta) \f$ at \f$ \omega = 0 \f$. sinc and its derivative
 /// come from detail::sinc_and_derivative (models/unicycle.hpp): a series below
-/// \f$ |a/2| < \epsilon^{1/8} \f$, so the Jacobian is exact and finite at every
-/// yaw rate, 0 included. With \f$ s_m = \sin m,\ c_m = \cos m \f$ and
+/// \f$ |a/2| < 0.125 \f$ (detail::kSincSeriesLimit), so the Jacobian is exact
+/// and finite at every yaw rate, 0 included, and an ordinary step costs one
+/// sine-cosine pair (of m). With \f$ s_m = \sin m,\ c_m = \cos m \f$ and
 /// \f$ k' = \mathrm{sinc}'(a/2) \f$, the non-trivial Jacobian entries are
 /// \f[ \partial p_x'/\partial(\theta, v, \omega) =
 ///     (-v\Delta t\,k s_m,\ \Delta t\,k c_m,\ \tfrac{v\Delta t^2}{2}(k' c_m - k s_m)) \f]
