@@ -479,9 +479,16 @@ class BasicEkf {
       // The gain half depends on P alone: reuse it while P repeats (a
       // converged, steady-state filter), bit for bit what it would compute.
       GainMemo<H>& memo = std::get<I>(memos_);
-      if (!detail::same_values(memo.P_in, P)) {
-        memo.valid = false;  // a new prior: record it, with no gain yet
-        memo.P_in = P;
+      if (!memo.recorded || !detail::same_values(memo.P_in, P)) {
+        // A new prior. Record it whole only when its first and last
+        // variances repeat those of the prior before (a candidate steady
+        // state), else just those two numbers: a filter whose P keeps
+        // changing pays two comparisons and two stores per update.
+        memo.valid = false;
+        memo.recorded = memo.first == P(0, 0) && memo.last == P(Dim - 1, Dim - 1);
+        if (memo.recorded) memo.P_in = P;
+        memo.first = P(0, 0);
+        memo.last = P(Dim - 1, Dim - 1);
         return detail::update_afresh<Options>(sensor, z, gates_[I], gate, x, P);
       }
       if (!memo.valid) {

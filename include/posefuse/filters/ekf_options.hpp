@@ -59,9 +59,10 @@ struct EkfOptions {
   static constexpr bool kRecordJacobian = true;
   /// Steady-state gain memo for time-invariant models (kTimeInvariant):
   /// keep the covariance half of the update and reuse it, bit for bit,
-  /// while P repeats (kept once the same P has been seen twice in a row).
-  /// Cost: one Dim x Dim comparison per update and, per model, a Dim x Dim
-  /// copy of P whenever P changed; the gain is copied once per new steady state.
+  /// while P repeats (kept once the same P has been seen three times in a
+  /// row). Cost while P changes: two comparisons and two stores per update;
+  /// in a steady state one Dim x Dim comparison per update; a copy of P and
+  /// of the gain once per new steady state.
   static constexpr bool kGainMemo = true;
 };
 

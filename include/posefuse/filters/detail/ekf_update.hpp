@@ -168,14 +168,20 @@ struct EkfGain {
 };
 
 /// The steady-state memo of one measurement model. A gain is kept only for
-/// a prior P seen twice in a row: an update whose P differs from P_in just
-/// records it (no gain copied, so a filter whose P keeps changing pays one
-/// comparison and one copy of P per update); the next update with the same
-/// P computes the gain into the memo; later ones with that P reuse it.
+/// a prior P seen three times in a row: an update whose P is new records
+/// its first and last variances; when the next prior repeats both, it is
+/// recorded whole (P_in); the next update with exactly P_in computes the
+/// gain into the memo; later ones with that P reuse it. So a filter whose
+/// P keeps changing pays two comparisons and two stores per update, not a
+/// copy of P.
 template <class H>
 struct EkfGainMemo {
   using Covariance = CovarianceOf<typename H::State>;
-  bool valid = false;  ///< gain holds the update for P_in
+  using Scalar = ScalarOf<typename H::State>;
+  bool valid = false;     ///< gain holds the update for P_in
+  bool recorded = false;  ///< P_in holds the last prior
+  Scalar first = std::numeric_limits<Scalar>::quiet_NaN();  ///< the last prior's P(0, 0)
+  Scalar last = std::numeric_limits<Scalar>::quiet_NaN();   ///< the last prior's P(Dim-1, Dim-1)
   Covariance P_in = Covariance::Constant(std::numeric_limits<ScalarOf<typename H::State>>::quiet_NaN());
   EkfGain<H> gain = EkfGain<H>::zero();
 };
