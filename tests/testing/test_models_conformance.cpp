@@ -256,9 +256,9 @@ TEMPLATE_TEST_CASE("Models conformance: unicycle_step's J_x and J_u", "[testing]
   using P = PlanarPose<T>;
   using U = Eigen::Matrix<T, 2, 1>;
   std::mt19937 rng(105);
-  // dtheta: exactly 0, tiny, both sides of the sinc series switch (|dtheta/2| = eps^(1/8),
-  // 0.011 in double, 0.14 in float), moderate, large, beyond pi.
-  const T thr = T(2) * std::sqrt(std::sqrt(std::sqrt(std::numeric_limits<T>::epsilon())));
+  // dtheta: exactly 0, tiny, both sides of the sinc series switch (|dtheta/2| =
+  // detail::kSincSeriesLimit), moderate, large, beyond pi.
+  const T thr = T(2) * posefuse::detail::kSincSeriesLimit<T>;
   const T dthetas[] = {T(0),   T(1e-9), T(-1e-5), thr * T(0.99), thr * T(1.01),
                        T(0.3), T(-2.5), T(3.0),   T(6.0)};
   const T dss[] = {T(0.7), T(-1.3), T(5.0)};
