@@ -329,15 +329,21 @@ void report_ceres(benchmark::State& state, const CeresRun& run, std::string labe
   if (!label.empty()) state.SetLabel(label);
 }
 
-void BM_PoseGraph4Dof_ceres(benchmark::State& state) {
-  const sim::PoseGraphProblem& pr = problem(static_cast<int>(state.range(0)));
+/// Ceres solving simulated problem pr from the poses `start`, timed.
+void time_ceres_from(benchmark::State& state, const sim::PoseGraphProblem& pr,
+                     const std::vector<Pose4Dof>& start) {
   CeresRun run{};
   for (auto _ : state) {
-    std::vector<std::array<double, 4>> x = bench::ceres_blocks_4dof(pr.initial);
+    std::vector<std::array<double, 4>> x = bench::ceres_blocks_4dof(start);
     run = bench::solve_4dof_with_ceres(pr.edges, pr.initial, x);
     benchmark::DoNotOptimize(x.data());
   }
   report_ceres(state, run, "");
+}
+
+void BM_PoseGraph4Dof_ceres(benchmark::State& state) {
+  const sim::PoseGraphProblem& pr = problem(static_cast<int>(state.range(0)));
+  time_ceres_from(state, pr, pr.initial);
 }
 BENCHMARK(BM_PoseGraph4Dof_ceres)
     ->Name("BM_PoseGraph4Dof/ceres")
@@ -358,15 +364,7 @@ const std::vector<Pose4Dof>& rotation_first_poses(int n) {
 
 void BM_PoseGraph4Dof_ceres_rotation_first(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
-  const sim::PoseGraphProblem& pr = problem(n);
-  const std::vector<Pose4Dof>& start = rotation_first_poses(n);
-  CeresRun run{};
-  for (auto _ : state) {
-    std::vector<std::array<double, 4>> x = bench::ceres_blocks_4dof(start);
-    run = bench::solve_4dof_with_ceres(pr.edges, pr.initial, x);
-    benchmark::DoNotOptimize(x.data());
-  }
-  report_ceres(state, run, "");
+  time_ceres_from(state, problem(n), rotation_first_poses(n));
 }
 BENCHMARK(BM_PoseGraph4Dof_ceres_rotation_first)
     ->Name("BM_PoseGraph4Dof/ceres_rotation_first")
