@@ -28,6 +28,7 @@
 #include <posefuse/models/se2_odometry.hpp>
 #include <posefuse/models/unicycle.hpp>
 #include <posefuse/testing/conformance.hpp>
+#include "support/random_matrices.hpp"
 
 using namespace posefuse;
 
@@ -79,18 +80,8 @@ struct Lean : EkfOptions {
 /// [lo, hi] times scale (a random rotation of a diagonal).
 template <int N>
 Eigen::Matrix<double, N, N> random_spd(std::mt19937& rng, double lo, double hi, double scale) {
-  std::normal_distribution<double> n01(0.0, 1.0);
   std::uniform_real_distribution<double> u(lo, hi);
-  Eigen::Matrix<double, N, N> A;
-  for (int i = 0; i < N; ++i)
-    for (int j = 0; j < N; ++j) A(i, j) = n01(rng);
-  Eigen::Matrix<double, N, N> Q = Eigen::Matrix<double, N, N>::Identity();
-  // Gram-Schmidt on A's columns.
-  for (int j = 0; j < N; ++j) {
-    Eigen::Matrix<double, N, 1> v = A.col(j);
-    for (int k = 0; k < j; ++k) v -= Q.col(k).dot(v) * Q.col(k);
-    Q.col(j) = v.normalized();
-  }
+  const Eigen::Matrix<double, N, N> Q = posefuse::test::random_orthogonal<N>(rng);
   Eigen::Matrix<double, N, 1> d;
   for (int i = 0; i < N; ++i) d(i) = u(rng) * scale;
   Eigen::Matrix<double, N, N> P = Q * d.asDiagonal() * Q.transpose();

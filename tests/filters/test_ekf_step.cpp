@@ -17,6 +17,7 @@
 #include <posefuse/models/planar_pose_fix.hpp>
 #include <posefuse/models/position.hpp>
 #include <posefuse/models/unicycle.hpp>
+#include "support/random_matrices.hpp"
 
 using namespace posefuse;
 
@@ -45,24 +46,11 @@ struct Dense3 {
   [[nodiscard]] Eigen::Matrix3d noise() const { return R; }
 };
 
-template <int N>
-Eigen::Matrix<double, N, N> random_rotation(std::mt19937& rng) {
-  std::normal_distribution<double> n01;
-  Eigen::Matrix<double, N, N> Q;
-  for (int j = 0; j < N; ++j) {
-    Eigen::Matrix<double, N, 1> v;
-    for (int i = 0; i < N; ++i) v(i) = n01(rng);
-    for (int k = 0; k < j; ++k) v -= Q.col(k).dot(v) * Q.col(k);
-    Q.col(j) = v.normalized();
-  }
-  return Q;
-}
-
 /// A symmetric matrix Q diag(lambda) Q^T, rows and columns scaled by s.
 template <int N>
 Eigen::Matrix<double, N, N> with_spectrum(std::mt19937& rng, const Eigen::Matrix<double, N, 1>& lambda,
                                           const Eigen::Matrix<double, N, 1>& s) {
-  const Eigen::Matrix<double, N, N> Q = random_rotation<N>(rng);
+  const Eigen::Matrix<double, N, N> Q = posefuse::test::random_orthogonal<N>(rng);
   Eigen::Matrix<double, N, N> M = s.asDiagonal() * Q * lambda.asDiagonal() * Q.transpose() * s.asDiagonal();
   return 0.5 * (M + M.transpose());
 }

@@ -17,6 +17,7 @@
 #include <posefuse/models/unicycle.hpp>
 #include <random>
 #include <vector>
+#include "support/random_matrices.hpp"
 
 using posefuse::Ctrv;
 using posefuse::CtrvState;
@@ -30,17 +31,8 @@ constexpr double kRel = 1e-12;
 /// diagonal with entries in [lo, 1] times scale (exactly symmetric).
 template <int N>
 Eigen::Matrix<double, N, N> random_spd(std::mt19937& rng, double lo, double scale) {
-  std::normal_distribution<double> n01(0.0, 1.0);
   std::uniform_real_distribution<double> u(std::log(lo), 0.0);
-  Eigen::Matrix<double, N, N> A;
-  for (int i = 0; i < N; ++i)
-    for (int j = 0; j < N; ++j) A(i, j) = n01(rng);
-  Eigen::Matrix<double, N, N> Q;
-  for (int j = 0; j < N; ++j) {  // Gram-Schmidt on A's columns
-    Eigen::Matrix<double, N, 1> v = A.col(j);
-    for (int k = 0; k < j; ++k) v -= Q.col(k).dot(v) * Q.col(k);
-    Q.col(j) = v.normalized();
-  }
+  const Eigen::Matrix<double, N, N> Q = posefuse::test::random_orthogonal<N>(rng);
   Eigen::Matrix<double, N, 1> d;
   for (int i = 0; i < N; ++i) d(i) = std::exp(u(rng)) * scale;
   const Eigen::Matrix<double, N, N> P = Q * d.asDiagonal() * Q.transpose();
