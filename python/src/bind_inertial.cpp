@@ -28,7 +28,6 @@ namespace py = pybind11;
 using namespace math;
 
 constexpr int kMinKeyframes = 4;   // fewer: 6 (N-1) equations cannot fix 3N+4 unknowns
-constexpr int kMaxKeyframes = 8;   // align_visual_inertial is compiled for kMinKeyframes .. kMaxKeyframes keyframes
 
 /// Seconds -> ns, refusing what int64 cannot hold.
 std::int64_t to_ns(double t_s, const std::string& what) {
@@ -150,14 +149,13 @@ ImuState make_state(const py::object& p, const py::object& R, const py::object& 
   return x;
 }
 
-template <int N>
-py::object align_n(const Stack& T, const SE3d& T_b_c, const std::vector<Preintegration>& pre_in,
+py::object align_n(int n, const Stack& T, const SE3d& T_b_c, const std::vector<Preintegration>& pre_in,
                    const VisualInertialAlignmentOptions& opt) {
-  std::array<SE3d, N> poses;
-  for (int k = 0; k < N; ++k) poses[std::size_t(k)] = se3_from_matrix(read<4, 4>(T.item(k)));
+  std::vector<SE3d> poses(std::size_t(n));
+  for (int k = 0; k < n; ++k) poses[std::size_t(k)] = se3_from_matrix(read<4, 4>(T.item(k)));
   std::vector<Preintegration> pre = pre_in;  // re-integrated copies; the caller's objects stay as they were
-  const VisualInertialAlignment<N> r =
-      align_visual_inertial<N>(poses, T_b_c, std::span<Preintegration, N - 1>(pre.data(), N - 1), opt);
+  const VisualInertialAlignmentResult r =
+      align_visual_inertial(std::span<const SE3d>(poses), T_b_c, std::span<Preintegration>(pre), opt);
   py::dict d;
   d["status"] = std::string(to_string(r.status));
   d["ok"] = r.status == VisualInertialAlignmentStatus::kOk;
@@ -166,11 +164,13 @@ py::object align_n(const Stack& T, const SE3d& T_b_c, const std::vector<Preinteg
   d["gravity_norm_unrefined"] = r.gravity_norm_unrefined;
   d["accel_std"] = r.accel_std;
   d["gyro_bias"] = to_numpy<3, 1>(r.gyro_bias);
-  auto vc0 = make({N}, {3}), vw = make({N}, {3}), Tw = make({N}, {4, 4});
-  for (int k = 0; k < N; ++k) {
-    write<3, 1>(vc0.mutable_data() + 3 * k, r.velocity_c0[std::size_t(k)]);
-    write<3, 1>(vw.mutable_data() + 3 * k, r.velocity_w[std::size_t(k)]);
-    write<4, 4>(Tw.mutable_data() + 16 * k, r.T_w_b[std::size_t(k)].matrix());
+  auto vc0 = make({n}, {3}), vw = make({n}, {3}), Tw = make({n}, {4, 4});
+  // Unsolved keyframes (a status other than ok) read as zero velocities and identity poses.
+  for (int k = 0; k < n; ++k) {
+    const std::size_t i = std::size_t(k);
+    write<3, 1>(vc0.mutable_data() + 3 * k, i < r.velocity_c0.size() ? r.velocity_c0[i] : Eigen::Vector3d::Zero());
+    write<3, 1>(vw.mutable_data() + 3 * k, i < r.velocity_w.size() ? r.velocity_w[i] : Eigen::Vector3d::Zero());
+    write<4, 4>(Tw.mutable_data() + 16 * k, i < r.T_w_b.size() ? r.T_w_b[i].matrix() : SE3d().matrix());
   }
   d["velocity_c0"] = vc0;
   d["R_w_c0"] = to_numpy<3, 3>(r.R_w_c0.matrix());
@@ -180,27 +180,15 @@ py::object align_n(const Stack& T, const SE3d& T_b_c, const std::vector<Preinteg
   return d;
 }
 
-template <int N>
-py::object align_dispatch(int n, const Stack& T, const SE3d& T_b_c, const std::vector<Preintegration>& pre,
-                          const VisualInertialAlignmentOptions& opt) {
-  if constexpr (N > kMaxKeyframes) {
-    throw py::value_error("align_visual_inertial: " + std::to_string(n) + " keyframes; " + std::to_string(kMinKeyframes) + " to " +
-                          std::to_string(kMaxKeyframes) + " are supported");
-  } else {
-    if (n == N) return align_n<N>(T, T_b_c, pre, opt);
-    return align_dispatch<N + 1>(n, T, T_b_c, pre, opt);
-  }
-}
-
 py::object align(const py::object& T_, const py::object& Tbc_, const std::vector<Preintegration>& pre, double G,
                  double min_accel_std, double max_gravity_norm_error, int refinement_iterations) {
   require_numpy("align_visual_inertial");
   const Stack T = stack_of(T_, {4, 4}, "align_visual_inertial: T_c0_c");
   if (T.lead.size() != 1) throw py::value_error("align_visual_inertial: T_c0_c: expected an array of shape (N, 4, 4), got " + shape_text(T.a));
   const int n = int(T.lead[0]);
-  if (n < kMinKeyframes || n > kMaxKeyframes)
-    throw py::value_error("align_visual_inertial: " + std::to_string(n) + " keyframes; " + std::to_string(kMinKeyframes) + " to " +
-                          std::to_string(kMaxKeyframes) + " are supported");
+  if (n < kMinKeyframes)
+    throw py::value_error("align_visual_inertial: " + std::to_string(n) + " keyframes; at least " +
+                          std::to_string(kMinKeyframes) + " are needed");
   if (int(pre.size()) != n - 1)
     throw py::value_error("align_visual_inertial: " + std::to_string(n) + " keyframes need " + std::to_string(n - 1) +
                           " pre-integrations, got " + std::to_string(pre.size()));
@@ -211,7 +199,7 @@ py::object align(const py::object& T_, const py::object& Tbc_, const std::vector
   opt.max_gravity_norm_error = finite(max_gravity_norm_error, "align_visual_inertial: max_gravity_norm_error");
   if (refinement_iterations < 0) throw py::value_error("align_visual_inertial: refinement_iterations must be >= 0");
   opt.refinement_iterations = refinement_iterations;
-  return align_dispatch<kMinKeyframes>(n, T, T_b_c, pre, opt);
+  return align_n(n, T, T_b_c, pre, opt);
 }
 
 }  // namespace

@@ -53,16 +53,22 @@
 /// * kGravityNorm: |g| of step 2 differs from G by more than
 ///   `max_gravity_norm_error` (default 1.0 m/s², as VINS-Mono).
 ///
-/// Fixed-size: N (≥ 3) is a template parameter, all matrices are
-/// (3N + 4)-sized Eigen fixed matrices on the stack. The accelerometer bias is
-/// not estimated (as in VINS-Mono's initialisation).
+/// The keyframe count N (≥ 4) is a run-time size: one compiled function
+/// serves every window length; an overload takes N as a template parameter
+/// and returns fixed-size arrays. The accelerometer bias is not estimated
+/// (as in VINS-Mono's initialisation).
 
 #include <Eigen/Core>
 #include <Eigen/QR>
 #include <array>
 #include <cmath>
 #include <span>
+#include <string>
 #include <type_traits>
+#include <vector>
+
+#include <posefuse/core/error.hpp>
+#include <posefuse/core/lazy.hpp>
 
 #include <posefuse/inertial/preintegration.hpp>
 #include <posefuse/lie/se3.hpp>
@@ -99,10 +105,26 @@ struct VisualInertialAlignmentOptions {
   int refinement_iterations = 4;        ///< gravity refinement iterations
 };
 
-/// The result of aligning N keyframes (valid only when status is kOk;
-/// diagnostics are filled as far as the computation went). Not to be
-/// confused with posefuse::AlignmentResult (eval/alignment.hpp), the
-/// similarity that aligns an estimated trajectory to a reference.
+/// The result of aligning a run-time number of keyframes (valid only when
+/// status is kOk; diagnostics are filled as far as the computation went).
+/// Not to be confused with posefuse::AlignmentResult (eval/alignment.hpp),
+/// the similarity that aligns an estimated trajectory to a reference.
+struct VisualInertialAlignmentResult {
+  /// outcome
+  VisualInertialAlignmentStatus status = VisualInertialAlignmentStatus::kSolveFailed;
+  double scale = 0;                    ///< s: metric = s × SfM units
+  Eigen::Vector3d gravity_c0 = Eigen::Vector3d::Zero();  ///< g in c0, refined (m/s²)
+  double gravity_norm_unrefined = 0;   ///< |g| of step 2 (m/s²)
+  double accel_std = 0;                ///< the excitation measure (m/s²)
+  Eigen::Vector3d gyro_bias = Eigen::Vector3d::Zero();   ///< estimated b_g (rad/s)
+  std::vector<Eigen::Vector3d> velocity_c0;              ///< v_k in c0 (m/s), one per keyframe when kOk
+  SO3d R_w_c0;                         ///< world (z up) from c0
+  std::vector<SE3d> T_w_b;             ///< body poses in the world frame (metric), one per keyframe when kOk
+  std::vector<Eigen::Vector3d> velocity_w;               ///< v_k in the world frame (m/s), one per keyframe when kOk
+};
+
+/// The result of aligning N keyframes: VisualInertialAlignmentResult with
+/// fixed-size arrays.
 template <int N>
 struct VisualInertialAlignment {
   /// outcome
@@ -118,30 +140,63 @@ struct VisualInertialAlignment {
   std::array<Eigen::Vector3d, N> velocity_w{};           ///< v_k in the world frame (m/s)
 };
 
-/// Visual-inertial alignment of N keyframes (see the file comment).
+namespace detail {
+
+/// x = argmin |M x - rhs| by column-pivoting Householder QR after scaling
+/// every column of M to unit norm; false when M is rank deficient or x is
+/// not finite.
+template <class Lazy = void>
+[[nodiscard]] bool scaled_qr_solve(const dependent_t<Eigen::MatrixXd, Lazy>& M, const Eigen::VectorXd& rhs,
+                                   Eigen::VectorXd& x) {
+  using Mat = dependent_t<Eigen::MatrixXd, Lazy>;
+  Eigen::VectorXd scale(M.cols());
+  for (Eigen::Index c = 0; c < M.cols(); ++c) {
+    const double n = M.col(c).norm();
+    scale(c) = n > 0 ? 1.0 / n : 1.0;
+  }
+  const Mat Ms = M * scale.asDiagonal();
+  const Eigen::ColPivHouseholderQR<Mat> qr(Ms);
+  if (qr.rank() < M.cols()) return false;
+  x = scale.asDiagonal() * qr.solve(rhs);
+  return bool(x.allFinite());
+}
+
+}  // namespace detail
+
+/// Visual-inertial alignment of `T_c0_c.size()` keyframes, at least 4 (see
+/// the file comment). The linear systems are sized at run time (6 (N − 1)
+/// rows, 3 N + 4 columns), so one compiled function serves every window length.
 /// @param[in] T_c0_c up-to-scale camera poses \f$ T_{c0,c_k} \f$ (first one ≈ identity)
 /// @param[in] T_b_c camera–IMU extrinsic (camera pose in the body frame, metric)
 /// @param[in,out] pre the N − 1 pre-integrations between consecutive keyframes;
 ///                re-integrated about the estimated gyroscope bias
 /// @param[in] options gravity norm, thresholds
-/// @throws posefuse::invalid_argument when a pre-integration has no step
-template <int N>
-[[nodiscard]] VisualInertialAlignment<N> align_visual_inertial(
-    const std::array<SE3d, N>& T_c0_c, const SE3d& T_b_c, std::span<Preintegration, N - 1> pre,
-    const VisualInertialAlignmentOptions& options = {}) {
+/// @throws posefuse::invalid_argument when fewer than 4 keyframes are given,
+///         `pre` does not hold N − 1 pre-integrations, or a pre-integration has no step
+template <class Lazy = void>
+[[nodiscard]] VisualInertialAlignmentResult align_visual_inertial(std::span<const SE3d> T_c0_c, const SE3d& T_b_c,
+                                                                  std::span<Preintegration> pre,
+                                                                  const VisualInertialAlignmentOptions& options = {}) {
   // 6 (N − 1) equations in 3 N + 4 unknowns: at N = 3, 12 equations in 13
   // unknowns, a system with a null space whatever the motion.
-  static_assert(N >= 4, "align_visual_inertial needs at least 4 keyframes: with 3, its 12 equations "
-                        "cannot determine the 13 unknowns (3 velocities, gravity, scale)");
+  const int N = int(T_c0_c.size());
+  if (N < 4)
+    throw invalid_argument("align_visual_inertial: " + std::to_string(N) +
+                           " keyframes; at least 4 are needed (with 3, its 12 equations cannot determine "
+                           "the 13 unknowns: 3 velocities, gravity, scale)");
+  if (pre.size() + 1 != T_c0_c.size())
+    throw invalid_argument("align_visual_inertial: " + std::to_string(N) + " keyframes need " +
+                           std::to_string(N - 1) + " pre-integrations, got " + std::to_string(pre.size()));
   using M3 = Eigen::Matrix3d;
-  constexpr int U = 3 * N + 4;        // unknowns [v_0..v_{N-1}, g, s]
-  constexpr int Rows = 6 * (N - 1);
-  VisualInertialAlignment<N> out;
+  using MatX = detail::dependent_t<Eigen::MatrixXd, Lazy>;
+  const int U = 3 * N + 4;  // unknowns [v_0..v_{N-1}, g, s]
+  const int Rows = 6 * (N - 1);
+  VisualInertialAlignmentResult out;
   for (const Preintegration& p : pre)
     if (!(p.dt_s() > 0)) throw invalid_argument("align_visual_inertial: a pre-integration has no step");
   const SO3d R_bc = T_b_c.so3();
   const Eigen::Vector3d p_bc = T_b_c.translation();
-  std::array<SO3d, N> R;  // R_{c0, b_k}
+  std::vector<SO3d> R(T_c0_c.size());  // R_{c0, b_k}
   for (int k = 0; k < N; ++k) R[k] = T_c0_c[k].so3().compose(R_bc.inverse());
 
   // 1. Gyroscope bias.
@@ -160,7 +215,7 @@ template <int N>
 
   // Excitation: spread of the mean specific force per pair, in c0.
   {
-    std::array<Eigen::Vector3d, N - 1> a;
+    std::vector<Eigen::Vector3d> a(std::size_t(N - 1));
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
     for (int k = 0; k + 1 < N; ++k) {
       a[k] = R[k].act(pre[k].delta().v) / pre[k].dt_s();
@@ -177,8 +232,8 @@ template <int N>
   }
 
   // 2. The linear system A x = y.
-  Eigen::Matrix<double, Rows, U> A = Eigen::Matrix<double, Rows, U>::Zero();
-  Eigen::Matrix<double, Rows, 1> y;
+  MatX A = MatX::Zero(Rows, U);
+  Eigen::VectorXd y(Rows);
   for (int k = 0; k + 1 < N; ++k) {
     const double T = pre[k].dt_s();
     const ImuDelta d = pre[k].delta();
@@ -192,21 +247,8 @@ template <int N>
     A.template block<3, 3>(r + 3, 3 * N) = -M3::Identity() * T;
     y.template segment<3>(r + 3) = R[k].act(d.v);
   }
-  const auto solve = [](const auto& M, const auto& rhs, auto& x) {
-    using Mat = std::remove_cvref_t<decltype(M)>;
-    Eigen::Matrix<double, Mat::ColsAtCompileTime, 1> scale;
-    for (int c = 0; c < M.cols(); ++c) {
-      const double n = M.col(c).norm();
-      scale(c) = n > 0 ? 1.0 / n : 1.0;
-    }
-    const Mat Ms = M * scale.asDiagonal();
-    const Eigen::ColPivHouseholderQR<Mat> qr(Ms);
-    if (qr.rank() < M.cols()) return false;
-    x = scale.asDiagonal() * qr.solve(rhs);
-    return bool(x.allFinite());
-  };
-  Eigen::Matrix<double, U, 1> x;
-  if (!solve(A, y, x)) return out;
+  Eigen::VectorXd x(U);
+  if (!detail::scaled_qr_solve<Lazy>(A, y, x)) return out;
   const double s0 = x(3 * N + 3);
   Eigen::Vector3d g = x.template segment<3>(3 * N);
   out.gravity_norm_unrefined = g.norm();
@@ -221,9 +263,10 @@ template <int N>
   }
 
   // 3. Gravity refinement on the sphere: unknowns [v, w (2), s].
-  constexpr int U2 = 3 * N + 3;
+  const int U2 = 3 * N + 3;
   Eigen::Vector3d g_hat = g.normalized();
-  Eigen::Matrix<double, U2, 1> x2;
+  Eigen::VectorXd x2(U2);
+  MatX A2(Rows, U2);
   for (int it = 0; it < options.refinement_iterations; ++it) {
     const Eigen::Vector3d t = std::abs(g_hat.x()) < 0.9 ? Eigen::Vector3d::UnitX()
                                                          : Eigen::Vector3d::UnitZ();
@@ -231,23 +274,24 @@ template <int N>
     const Eigen::Vector3d b2 = g_hat.cross(b1);
     Eigen::Matrix<double, 3, 2> B;
     B << b1, b2;
-    Eigen::Matrix<double, Rows, U2> A2;
-    A2.template leftCols<3 * N>() = A.template leftCols<3 * N>();
-    A2.template block<Rows, 2>(0, 3 * N) = A.template block<Rows, 3>(0, 3 * N) * B;
+    A2.leftCols(3 * N) = A.leftCols(3 * N);
+    A2.middleCols(3 * N, 2) = A.middleCols(3 * N, 3) * B;
     A2.col(3 * N + 2) = A.col(3 * N + 3);
-    const Eigen::Matrix<double, Rows, 1> y2 =
-        y - A.template block<Rows, 3>(0, 3 * N) * (options.gravity_norm * g_hat);
-    if (!solve(A2, y2, x2)) return out;
+    const Eigen::VectorXd y2 = y - A.middleCols(3 * N, 3) * (options.gravity_norm * g_hat);
+    if (!detail::scaled_qr_solve<Lazy>(A2, y2, x2)) return out;
     g_hat = (options.gravity_norm * g_hat + B * x2.template segment<2>(3 * N)).normalized();
   }
-  const double s = x2(3 * N + 2);
+  const double s = options.refinement_iterations > 0 ? x2(3 * N + 2) : s0;
   out.scale = s;
   out.gravity_c0 = options.gravity_norm * g_hat;
   if (!(s > 0)) {
     out.status = VisualInertialAlignmentStatus::kNonPositiveScale;
     return out;
   }
-  for (int k = 0; k < N; ++k) out.velocity_c0[k] = x2.template segment<3>(3 * k);
+  out.velocity_c0.resize(std::size_t(N));
+  for (int k = 0; k < N; ++k)
+    out.velocity_c0[k] = options.refinement_iterations > 0 ? Eigen::Vector3d(x2.template segment<3>(3 * k))
+                                                           : Eigen::Vector3d(x.template segment<3>(3 * k));
 
   // 4. World frame: gravity along -z, first body's yaw zero.
   const Eigen::Quaterniond q_tilt =
@@ -257,12 +301,47 @@ template <int N>
   const double yaw = std::atan2(Rb0(1, 0), Rb0(0, 0));
   out.R_w_c0 = SO3d::exp(Eigen::Vector3d(0, 0, -yaw)).compose(R_tilt);
   const Eigen::Vector3d p0 = s * T_c0_c[0].translation() - R[0].act(p_bc);
+  out.T_w_b.resize(std::size_t(N));
+  out.velocity_w.resize(std::size_t(N));
   for (int k = 0; k < N; ++k) {
     const Eigen::Vector3d pk = s * T_c0_c[k].translation() - R[k].act(p_bc);
     out.T_w_b[k] = SE3d(out.R_w_c0.act(pk - p0), out.R_w_c0.compose(R[k]));
     out.velocity_w[k] = out.R_w_c0.act(out.velocity_c0[k]);
   }
   out.status = VisualInertialAlignmentStatus::kOk;
+  return out;
+}
+
+/// Visual-inertial alignment of N keyframes (see the file comment): the
+/// run-time overload above, with the keyframe count checked at compile time
+/// and the result in fixed-size arrays.
+/// @param[in] T_c0_c up-to-scale camera poses \f$ T_{c0,c_k} \f$ (first one ≈ identity)
+/// @param[in] T_b_c camera–IMU extrinsic (camera pose in the body frame, metric)
+/// @param[in,out] pre the N − 1 pre-integrations between consecutive keyframes;
+///                re-integrated about the estimated gyroscope bias
+/// @param[in] options gravity norm, thresholds
+/// @throws posefuse::invalid_argument when a pre-integration has no step
+template <int N>
+[[nodiscard]] VisualInertialAlignment<N> align_visual_inertial(
+    const std::array<SE3d, N>& T_c0_c, const SE3d& T_b_c, std::span<Preintegration, N - 1> pre,
+    const VisualInertialAlignmentOptions& options = {}) {
+  static_assert(N >= 4, "align_visual_inertial needs at least 4 keyframes: with 3, its 12 equations "
+                        "cannot determine the 13 unknowns (3 velocities, gravity, scale)");
+  const VisualInertialAlignmentResult r =
+      align_visual_inertial(std::span<const SE3d>(T_c0_c), T_b_c, std::span<Preintegration>(pre), options);
+  VisualInertialAlignment<N> out;
+  out.status = r.status;
+  out.scale = r.scale;
+  out.gravity_c0 = r.gravity_c0;
+  out.gravity_norm_unrefined = r.gravity_norm_unrefined;
+  out.accel_std = r.accel_std;
+  out.gyro_bias = r.gyro_bias;
+  out.R_w_c0 = r.R_w_c0;
+  for (std::size_t k = 0; k < r.velocity_c0.size() && k < std::size_t(N); ++k) out.velocity_c0[k] = r.velocity_c0[k];
+  for (std::size_t k = 0; k < r.T_w_b.size() && k < std::size_t(N); ++k) {
+    out.T_w_b[k] = r.T_w_b[k];
+    out.velocity_w[k] = r.velocity_w[k];
+  }
   return out;
 }
 
