@@ -4,7 +4,7 @@
 # numpy and pytest for its tests) -- and only those that are missing. Safe
 # to run again: on a machine that has them all it does nothing.
 set -euo pipefail
-packages=(cmake g++ make libeigen3-dev catch2 libbenchmark-dev
+packages=(cmake g++ make ninja-build libeigen3-dev catch2 libbenchmark-dev
           pybind11-dev python3-dev python3-numpy python3-pytest)
 missing=()
 for p in "${packages[@]}"; do
