@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <posefuse/eval/alignment.hpp>
+#include "support/camera_constants.hpp"
 #include <posefuse/vio/sfm.hpp>
 
 using posefuse::SE3d;
@@ -20,8 +21,8 @@ using posefuse::SO3d;
 
 namespace {
 
-constexpr double kFocal = 460.0;
-constexpr double kDeg = std::numbers::pi / 180.0;
+using posefuse_test::kDeg;
+using posefuse_test::kFocal;
 
 struct Window {
   std::vector<SE3d> T_w_c;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <posefuse/testing/conformance.hpp>
+#include "support/camera_constants.hpp"
 #include <posefuse/vio/triangulation.hpp>
 #include <posefuse/vio/two_view.hpp>
 
@@ -20,8 +21,8 @@ using posefuse::TwoViewStatus;
 
 namespace {
 
-constexpr double kFocal = 460.0;
-constexpr double kDeg = std::numbers::pi / 180.0;
+using posefuse_test::kDeg;
+using posefuse_test::kFocal;
 
 struct Pairs {
   SE3d T_1_2;
