@@ -1,6 +1,7 @@
 """Builds posefuse's extension module with the project's own CMake build.
 
-pyproject.toml holds the metadata; this file adds what a static table cannot:
+pyproject.toml holds the metadata; this file adds the package layout (the
+package is python/posefuse) and what a static table cannot:
 the version, read from CMakeLists.txt's project(... VERSION x.y.z ...) (the one
 place it is set; CMake also compiles it into the module as __version__), and a
 build_ext that configures the repository with CMake for the interpreter running
@@ -68,10 +69,14 @@ class CMakeBuild(build_ext):
 
 
 # Keep setuptools' own build and egg-info folders out of the CMake preset's build/.
-(ROOT / "build-pip").mkdir(exist_ok=True)
+BUILD = ROOT / "build-pip"
+BUILD.mkdir(exist_ok=True)
 setup(
     version=project_version(),
+    package_dir={"": "python"},
+    packages=["posefuse"],
+    package_data={"posefuse": ["py.typed", "*.pyi"]},
     ext_modules=[Extension("posefuse._posefuse", sources=[])],
     cmdclass={"build_ext": CMakeBuild},
-    options={"build": {"build_base": "build-pip"}, "egg_info": {"egg_base": "build-pip"}},
+    options={"build": {"build_base": str(BUILD)}, "egg_info": {"egg_base": str(BUILD)}},
 )
