@@ -9,12 +9,19 @@
 #      `build/examples/` replaced by the directory of the built programs; a
 #      non-zero exit fails the check. Only commands that need no real data
 #      are marked so;
-#  (c) every relative link `[text](target)` outside code must name an
+#  (c) a code block right after a line `<!-- prints: COMMAND -->` must equal
+#      what COMMAND prints on standard output (run with bash as in (b), in a
+#      fresh temporary directory, `build/examples/` replaced the same way),
+#      byte for byte: the output blocks of the programs' built-in runs cannot
+#      drift from what the programs print. Only fast, data-free commands are
+#      marked so;
+#  (d) every relative link `[text](target)` outside code must name an
 #      existing file or directory (anchors are not checked).
 #
 # Usage: scripts/check-doc-commands.sh [PROGRAM_DIR]
 #   PROGRAM_DIR  where the example programs were built (default:
 #                build/examples of the checkout, the default preset's).
+# Documents: README.md, CHANGELOG.md, docs/*.md and docs/*/*.md.
 # Exit status: 0 when everything holds, 1 otherwise (each failure is named
 # as document:line on stderr).
 set -euo pipefail
@@ -31,7 +38,7 @@ trap 'rm -rf "$work"' EXIT
 
 docs=("$root/README.md")
 [[ -f $root/CHANGELOG.md ]] && docs+=("$root/CHANGELOG.md")
-for f in "$root"/docs/*.md; do [[ -f $f ]] && docs+=("$f"); done
+for f in "$root"/docs/*.md "$root"/docs/*/*.md; do [[ -f $f ]] && docs+=("$f"); done
 
 failures=0
 fail() {
@@ -43,6 +50,7 @@ fail() {
 # $work/index gets one tab-separated line per item:
 #   file  <n> <path>   <doc>:<line>
 #   check <n> -        <doc>:<line>
+#   prints <n> <command> <doc>:<line>
 #   link  -   <target> <doc>:<line>
 #   error -   <text>   <doc>:<line>
 n=0
@@ -69,7 +77,7 @@ for doc in "${docs[@]}"; do
           n++
           out = dir "/block." n
           printf "" > out
-          printf "%s\t%d\t%s\t%s:%d\n", kind, n, (kind == "file" ? arg : "-"), doc, mline >> (dir "/index")
+          printf "%s\t%d\t%s\t%s:%d\n", kind, n, (kind == "check" ? "-" : arg), doc, mline >> (dir "/index")
           kind = ""
         }
         next
@@ -78,6 +86,12 @@ for doc in "${docs[@]}"; do
         flush_marker("is not followed by a code block")
         kind = "file"; mline = NR
         arg = line; sub(/^<!-- file: /, "", arg); sub(/ -->[ \t]*$/, "", arg)
+        next
+      }
+      if (match(line, /^<!-- prints: .+ -->[ \t]*$/)) {
+        flush_marker("is not followed by a code block")
+        kind = "prints"; mline = NR
+        arg = line; sub(/^<!-- prints: /, "", arg); sub(/ -->[ \t]*$/, "", arg)
         next
       }
       if (line ~ /^<!-- check -->[ \t]*$/) {
@@ -105,7 +119,24 @@ for doc in "${docs[@]}"; do
     }' "$doc")
 done
 
-files=0 checks=0 links=0
+files=0 checks=0 prints=0 links=0
+
+# Runs a command block or a prints command ($1: the script file) with the
+# programs of $bin; stdout to $2, stderr to $3. Fails when a program it names
+# is not built.
+run_block() {
+  local script=$1 out=$2 err=$3 prog missing="" dir
+  for prog in $(grep -o 'build/examples/[A-Za-z0-9_]*' "$script" | sort -u); do
+    [[ -x $bin/${prog#build/examples/} ]] || missing+=" ${prog#build/examples/}"
+  done
+  if [[ -n $missing ]]; then
+    echo "not built in $bin:$missing" >"$err"
+    return 1
+  fi
+  dir=$(mktemp -d "$work/run.XXXXXX")
+  sed "s#build/examples/#$bin/#g" "$script" >"$dir.sh"
+  (cd "$dir" && timeout 600 bash -euo pipefail "$dir.sh") </dev/null >"$out" 2>"$err"
+}
 while IFS=$'\t' read -r -u 3 kind num arg where; do
   case $kind in
     error)
@@ -122,22 +153,21 @@ while IFS=$'\t' read -r -u 3 kind num arg where; do
       ;;
     check)
       checks=$((checks + 1))
-      script=$work/block.$num
-      missing=""
-      for prog in $(grep -o 'build/examples/[A-Za-z0-9_]*' "$script" | sort -u); do
-        [[ -x $bin/${prog#build/examples/} ]] || missing+=" ${prog#build/examples/}"
-      done
-      if [[ -n $missing ]]; then
-        fail "$where: not built in $bin:$missing"
-        continue
-      fi
-      run=$work/run.$num
-      mkdir "$run"
-      sed "s#build/examples/#$bin/#g" "$script" >"$run.sh"
-      if ! (cd "$run" && timeout 600 bash -euo pipefail "$run.sh") </dev/null >"$run.log" 2>&1; then
+      if ! run_block "$work/block.$num" "$work/out.$num" "$work/err.$num"; then
         fail "$where: the command block failed:"
-        sed 's/^/  | /' "$script" >&2
-        tail -n 20 "$run.log" | sed 's/^/  > /' >&2
+        sed 's/^/  | /' "$work/block.$num" >&2
+        cat "$work/out.$num" "$work/err.$num" 2>/dev/null | tail -n 20 | sed 's/^/  > /' >&2
+      fi
+      ;;
+    prints)
+      prints=$((prints + 1))
+      printf '%s\n' "$arg" >"$work/cmd.$num"
+      if ! run_block "$work/cmd.$num" "$work/out.$num" "$work/err.$num"; then
+        fail "$where: the command '$arg' failed:"
+        tail -n 20 "$work/err.$num" | sed 's/^/  > /' >&2
+      elif ! cmp -s "$work/block.$num" "$work/out.$num"; then
+        fail "$where: the block differs from what '$arg' prints (- document, + program):"
+        diff -u "$work/block.$num" "$work/out.$num" | sed -n '3,40p' >&2 || true
       fi
       ;;
     link)
@@ -154,4 +184,5 @@ if ((failures > 0)); then
   exit 1
 fi
 echo "check-doc-commands: ${#docs[@]} documents: $files file blocks equal their files," \
-  "$checks command blocks ran, $links relative links resolve"
+  "$checks command blocks ran, $prints output blocks equal what their commands print," \
+  "$links relative links resolve"

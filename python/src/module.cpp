@@ -65,7 +65,7 @@ void register_errors(py::module_& m) {
 
 PYBIND11_MODULE(_posefuse, m) {
   m.doc() = "posefuse: trajectory evaluation, Lie groups, pose graphs, IMU pre-integration and filters";
-  m.attr("__version__") = "0.1.0";
+  m.attr("__version__") = POSEFUSE_VERSION;  // CMake's project(VERSION), from python/CMakeLists.txt
   register_errors(m);
 #ifdef POSEFUSE_PY_HAS_TRAJECTORY
   posefuse::python::bind_trajectory(m);

@@ -1,9 +1,11 @@
 #!/usr/bin/env python3
 """Independent pure-Python cross-check of posefuse's evo-equivalent metrics.
 
-Not run by ctest (numpy/evo are not available on the build machines). It
-re-derives, from the published definitions and without numpy, the numbers
-that tests/eval/test_metrics.cpp checks on KITTI 06:
+Plain Python 3, no numpy and no evo; it reads KITTI 06 from the data folder
+and runs in under a second. Not part of ctest: its output is what
+tests/eval/test_metrics.cpp's KITTI 06 cases require of posefuse (to 1e-5),
+and docs/evaluation.md ("Agreement with evo") shows it. It re-derives, from
+evo's published definitions, the numbers that those cases check:
 
   * association: nearest timestamp of the shorter trajectory in the longer
     one (first minimum), kept when |dt| <= 0.01 s;

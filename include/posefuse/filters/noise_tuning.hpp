@@ -110,6 +110,9 @@ struct NoiseTuningResult {
 };
 
 /// Maximises `log_likelihood(process, measurement)` over the box
+/// @param[in] process search interval of the process noise level
+/// @param[in] measurement search interval of the measurement noise level
+/// @param[in] options grid size, evaluation budget and tolerance
 /// `process` x `measurement` (see the file comment). A non-finite value
 /// counts as -infinity.
 /// @param[in] log_likelihood callable `double(double p, double m)`

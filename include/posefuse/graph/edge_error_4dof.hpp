@@ -123,6 +123,9 @@ template <class Lazy = void>
 
 /// The 4-DoF edge error \f$ e = [e_t; e_\psi] \f$ (see the file comment) and
 /// its Jacobians with respect to \f$ x_i = [p_i; \psi_i] \f$ and \f$ x_j \f$.
+/// @param[in] pi, yaw_i node i's position and yaw
+/// @param[in] pj, yaw_j node j's position and yaw
+/// @param[in] dp, dyaw the edge's measured position (in node i's yaw frame) and yaw change
 /// @param[in] Qi_t \f$ Q_i^\top \f$, node i's fixed roll/pitch rotation transposed
 /// @param[out] J_e_xi if not null, \f$ \partial e / \partial [p_i; \psi_i] \f$ (4x4)
 /// @param[out] J_e_xj if not null, \f$ \partial e / \partial [p_j; \psi_j] \f$ (4x4)
@@ -145,6 +148,9 @@ template <class Lazy = void>
 /// \f$ t2v(Z^{-1} X_i^{-1} X_j) \f$): edge_error_4dof with z = 0 and no roll
 /// or pitch, on \f$ x_i = [x_i, y_i, \psi_i] \f$:
 /// \f$ e = [R(\Delta\psi)^\top (R(\psi_i)^\top (p_j - p_i) - \Delta p);\ \mathrm{wrap}(\psi_j - \psi_i - \Delta\psi)] \f$.
+/// @param[in] pi, yaw_i node i's position and heading
+/// @param[in] pj, yaw_j node j's position and heading
+/// @param[in] dp, dyaw the edge's measured displacement (in node i's frame) and heading change
 /// @param[out] J_e_xi if not null, \f$ \partial e / \partial [p_i; \psi_i] \f$ (3x3)
 /// @param[out] J_e_xj if not null, \f$ \partial e / \partial [p_j; \psi_j] \f$ (3x3)
 template <class Lazy = void>

@@ -102,6 +102,8 @@ template <class Lazy = void>
 
 /// The SE(3) edge error \f$ e = [t_E; v] \f$ of an edge measuring Z between
 /// nodes at X_i and X_j (see the file comment), and its Jacobians.
+/// @param[in] xi, xj the poses of nodes i and j
+/// @param[in] z the edge's measurement, node j in node i's frame
 /// @param[out] J_e_xi if not null, \f$ \partial e / \partial \delta_i \f$ (6x6, see pose_graph_plus)
 /// @param[out] J_e_xj if not null, \f$ \partial e / \partial \delta_j \f$
 template <class Lazy = void>

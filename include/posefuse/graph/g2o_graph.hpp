@@ -35,6 +35,7 @@ template <class Lazy = void>
 
 /// The 4-DoF pose graph of a planar g2o graph (`FIX` ids held fixed; with
 /// none, optimize() holds the first vertex).
+/// @param[in] g the parsed planar g2o graph
 /// @param[in] loss robust loss given to every edge
 /// @throws posefuse::invalid_argument as PoseGraph4Dof::add_node / add_edge
 ///         (duplicate vertex ids, an edge naming a missing vertex, ...)
@@ -72,6 +73,7 @@ template <class Lazy = void>
 }
 
 /// The SE(3) pose graph of a 3-D g2o graph (`FIX` ids held fixed; with
+/// @param[in] g the parsed 3-D g2o graph
 /// none, optimize() holds the first vertex). Its cost is g2o's χ².
 /// @param[in] loss robust loss given to every edge
 /// @throws posefuse::invalid_argument as PoseGraphSE3::add_node / add_edge

@@ -102,6 +102,7 @@ class ImuFactor {
   }
 
   /// The residual r(x_i, x_j) (not whitened).
+  /// @param[in] xi, xj the states at keyframes i and j
   /// @param[out] J_r_i, J_r_j if not null, \f$ \partial r / \partial x_i \f$ and
   ///             \f$ \partial r / \partial x_j \f$ (right perturbations; file comment)
   template <class Lazy = void>

@@ -102,6 +102,10 @@ template <class Lazy = void>
 }
 
 /// Throws when one wheels.csv increment implies more than the speed limit.
+/// @param[in] w the wheel samples of wheels.csv
+/// @param[in] p the robot's parameters (ticks per revolution, wheel radius)
+/// @param[in] file wheels.csv's path, for the messages
+/// @param[in] lim the limits (the speed limit among them)
 /// @param[in] lines 1-based line of each row (empty: "data row K" is named)
 /// @throws posefuse::io_error (file:line) naming wheel, ticks, time and speed
 template <class Lazy = void>
@@ -261,6 +265,7 @@ template <class Lazy = void>
 }
 
 /// Runs every check of the file comment on a whole log.
+/// @param[in] lim the limits of the checks
 /// @param[in] log the log
 /// @param[in] dir its folder, for the file names in messages (empty: bare names)
 /// @return the warnings, each starting with the file name

@@ -101,6 +101,7 @@ class SE2 {
     return SE2(-Ri.act(t_), Ri);
   }
   /// \f$ c = a\,b = (t_a + R_a t_b, R_a R_b) \f$ (this = a).
+  /// @param[in] b the right operand
   /// @param[out] J_c_a if not null, \f$ \mathrm{Ad}_b^{-1} \f$ (Solà, Jacobian of the composition)
   /// @param[out] J_c_b if not null, \f$ I \f$
   [[nodiscard]] SE2 compose(const SE2& b, Jacobian* J_c_a = nullptr,
@@ -112,6 +113,7 @@ class SE2 {
   /// \f$ a\,b \f$ without Jacobians.
   [[nodiscard]] SE2 operator*(const SE2& b) const noexcept { return compose(b); }
   /// \f$ d = a^{-1} b = (R_a^\top (t_b - t_a), R_a^\top R_b) \f$ (this = a): b seen from a.
+  /// @param[in] b the right operand
   /// @param[out] J_d_a if not null, \f$ -\mathrm{Ad}_d^{-1} \f$
   /// @param[out] J_d_b if not null, \f$ I \f$
   [[nodiscard]] SE2 between(const SE2& b, Jacobian* J_d_a = nullptr,
@@ -123,6 +125,7 @@ class SE2 {
     return d;
   }
   /// \f$ q = R p + t \f$.
+  /// @param[in] p the point
   /// @param[out] J_q_g if not null, \f$ [R,\; R [1]_\times p] \f$
   /// @param[out] J_q_p if not null, \f$ R \f$
   [[nodiscard]] Point act(const Point& p, ActJacobianGroup* J_q_g = nullptr,
@@ -137,6 +140,7 @@ class SE2 {
   }
 
   /// \f$ y = x \oplus \tau = x\,\mathrm{Exp}(\tau) \f$.
+  /// @param[in] d the tangent \f$ \tau \f$
   /// @param[out] J_y_x if not null, \f$ \mathrm{Ad}_{\mathrm{Exp}(\tau)}^{-1} \f$
   /// @param[out] J_y_d if not null, \f$ J_r(\tau) \f$
   [[nodiscard]] SE2 plus(const Tangent& d, Jacobian* J_y_x = nullptr,
@@ -145,6 +149,7 @@ class SE2 {
     return compose(e, J_y_x);
   }
   /// \f$ d = y \ominus x = \mathrm{Log}(x^{-1} y) \f$ (this = y).
+  /// @param[in] x the element subtracted
   /// @param[out] J_d_y if not null, \f$ J_r^{-1}(d) \f$
   /// @param[out] J_d_x if not null, \f$ -J_l^{-1}(d) \f$
   [[nodiscard]] Tangent minus(const SE2& x, Jacobian* J_d_y = nullptr,

@@ -101,6 +101,7 @@ class SE3 {
     return SE3(-Ri.act(t_), Ri);
   }
   /// \f$ c = a\,b = (t_a + R_a t_b, R_a R_b) \f$ (this = a).
+  /// @param[in] b the right operand
   /// @param[out] J_c_a if not null, \f$ \mathrm{Ad}_b^{-1} \f$ (Solà, Jacobian of the composition)
   /// @param[out] J_c_b if not null, \f$ I \f$
   [[nodiscard]] SE3 compose(const SE3& b, Jacobian* J_c_a = nullptr,
@@ -112,6 +113,7 @@ class SE3 {
   /// \f$ a\,b \f$ without Jacobians.
   [[nodiscard]] SE3 operator*(const SE3& b) const noexcept { return compose(b); }
   /// \f$ d = a^{-1} b = (R_a^\top (t_b - t_a), R_a^\top R_b) \f$ (this = a).
+  /// @param[in] b the right operand
   /// @param[out] J_d_a if not null, \f$ -\mathrm{Ad}_d^{-1} \f$
   /// @param[out] J_d_b if not null, \f$ I \f$
   [[nodiscard]] SE3 between(const SE3& b, Jacobian* J_d_a = nullptr,
@@ -123,6 +125,7 @@ class SE3 {
     return d;
   }
   /// \f$ q = R p + t \f$.
+  /// @param[in] p the point
   /// @param[out] J_q_g if not null, \f$ [R,\; -R[p]_\times] \f$
   /// @param[out] J_q_p if not null, \f$ R \f$
   [[nodiscard]] Point act(const Point& p, ActJacobianGroup* J_q_g = nullptr,
@@ -139,6 +142,7 @@ class SE3 {
   }
 
   /// \f$ y = x \oplus \tau = x\,\mathrm{Exp}(\tau) \f$.
+  /// @param[in] d the tangent \f$ \tau \f$
   /// @param[out] J_y_x if not null, \f$ \mathrm{Ad}_{\mathrm{Exp}(\tau)}^{-1} \f$
   /// @param[out] J_y_d if not null, \f$ J_r(\tau) \f$
   [[nodiscard]] SE3 plus(const Tangent& d, Jacobian* J_y_x = nullptr,
@@ -146,6 +150,7 @@ class SE3 {
     return compose(exp(d, J_y_d), J_y_x);
   }
   /// \f$ d = y \ominus x = \mathrm{Log}(x^{-1} y) \f$ (this = y).
+  /// @param[in] x the element subtracted
   /// @param[out] J_d_y if not null, \f$ J_r^{-1}(d) \f$
   /// @param[out] J_d_x if not null, \f$ -J_l^{-1}(d) \f$
   [[nodiscard]] Tangent minus(const SE3& x, Jacobian* J_d_y = nullptr,

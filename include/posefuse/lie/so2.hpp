@@ -81,6 +81,7 @@ class SO2 {
     return SO2(c_, -s_, Unchecked{});
   }
   /// \f$ c = a \cdot b \f$ (this = a): the angles add.
+  /// @param[in] b the right operand
   /// @param[out] J_c_a if not null, \f$ \mathrm{Ad}_b^{-1} = 1 \f$
   /// @param[out] J_c_b if not null, 1
   [[nodiscard]] SO2 compose(const SO2& b, Jacobian* J_c_a = nullptr,
@@ -92,6 +93,7 @@ class SO2 {
   /// \f$ a \cdot b \f$ without Jacobians.
   [[nodiscard]] SO2 operator*(const SO2& b) const noexcept { return compose(b); }
   /// \f$ d = a^{-1} b \f$ (this = a).
+  /// @param[in] b the right operand
   /// @param[out] J_d_a if not null, \f$ -\mathrm{Ad}_d^{-1} = -1 \f$
   /// @param[out] J_d_b if not null, 1
   [[nodiscard]] SO2 between(const SO2& b, Jacobian* J_d_a = nullptr,
@@ -101,6 +103,7 @@ class SO2 {
     return normalized(c_ * b.c_ + s_ * b.s_, c_ * b.s_ - s_ * b.c_);
   }
   /// \f$ q = R p \f$.
+  /// @param[in] p the point
   /// @param[out] J_q_g if not null, \f$ R\,[1]_\times p = R\,(-p_y, p_x)^\top \f$
   /// @param[out] J_q_p if not null, \f$ R \f$
   [[nodiscard]] Point act(const Point& p, ActJacobianGroup* J_q_g = nullptr,
@@ -112,6 +115,7 @@ class SO2 {
   }
 
   /// \f$ y = x \oplus \tau = x \cdot \mathrm{Exp}(\tau) \f$.
+  /// @param[in] d the tangent \f$ \tau \f$
   /// @param[out] J_y_x if not null, \f$ \mathrm{Ad}_{\mathrm{Exp}(\tau)}^{-1} = 1 \f$
   /// @param[out] J_y_d if not null, \f$ J_r(\tau) = 1 \f$
   [[nodiscard]] SO2 plus(const Tangent& d, Jacobian* J_y_x = nullptr,
@@ -121,6 +125,7 @@ class SO2 {
     return compose(SO2(d(0)));
   }
   /// \f$ d = y \ominus x = \mathrm{Log}(x^{-1} y) \f$ (this = y), in [-π, π).
+  /// @param[in] x the element subtracted
   /// @param[out] J_d_y if not null, \f$ J_r^{-1}(d) = 1 \f$
   /// @param[out] J_d_x if not null, \f$ -J_l^{-1}(d) = -1 \f$
   [[nodiscard]] Tangent minus(const SO2& x, Jacobian* J_d_y = nullptr,

@@ -98,6 +98,7 @@ class SO3 {
   [[nodiscard]] static SO3 identity() noexcept { return SO3(); }
 
   /// \f$ \mathrm{Exp}(\phi) \f$, the rotation by θ = |φ| rad about φ/θ (see the file comment).
+  /// @param[in] phi the rotation vector \f$ \phi \f$ (rad)
   /// Not validated (hot path): a non-finite φ gives a non-finite rotation.
   /// @param[out] J_g_tau if not null, \f$ J_r(\phi) \f$
   [[nodiscard]] static SO3 exp(const Tangent& phi, Jacobian* J_g_tau = nullptr) noexcept {
@@ -142,6 +143,7 @@ class SO3 {
     return SO3(q_.conjugate(), Unchecked{});
   }
   /// \f$ c = a\,b \f$ (this = a), renormalised so long chains stay unit.
+  /// @param[in] b the right operand
   /// @param[out] J_c_a if not null, \f$ \mathrm{Ad}_b^{-1} = R_b^\top \f$
   ///             (Solà, Jacobian of the composition)
   /// @param[out] J_c_b if not null, \f$ I \f$
@@ -154,6 +156,7 @@ class SO3 {
   /// \f$ a\,b \f$ without Jacobians.
   [[nodiscard]] SO3 operator*(const SO3& b) const noexcept { return compose(b); }
   /// \f$ d = a^{-1} b \f$ (this = a).
+  /// @param[in] b the right operand
   /// @param[out] J_d_a if not null, \f$ -\mathrm{Ad}_d^{-1} = -R_d^\top \f$
   /// @param[out] J_d_b if not null, \f$ I \f$
   [[nodiscard]] SO3 between(const SO3& b, Jacobian* J_d_a = nullptr,
@@ -164,6 +167,7 @@ class SO3 {
     return d;
   }
   /// \f$ q = R p \f$.
+  /// @param[in] p the point
   /// @param[out] J_q_g if not null, \f$ -R [p]_\times \f$
   /// @param[out] J_q_p if not null, \f$ R \f$
   [[nodiscard]] Point act(const Point& p, ActJacobianGroup* J_q_g = nullptr,
@@ -177,6 +181,7 @@ class SO3 {
   }
 
   /// \f$ y = x \oplus \phi = x\,\mathrm{Exp}(\phi) \f$.
+  /// @param[in] d the tangent \f$ \tau \f$
   /// @param[out] J_y_x if not null,
   ///             \f$ \mathrm{Ad}_{\mathrm{Exp}(\phi)}^{-1} = \mathrm{Exp}(\phi)^\top \f$
   /// @param[out] J_y_d if not null, \f$ J_r(\phi) \f$
@@ -185,6 +190,7 @@ class SO3 {
     return compose(exp(d, J_y_d), J_y_x);
   }
   /// \f$ d = y \ominus x = \mathrm{Log}(x^{-1} y) \f$ (this = y).
+  /// @param[in] x the element subtracted
   /// @param[out] J_d_y if not null, \f$ J_r^{-1}(d) \f$
   /// @param[out] J_d_x if not null, \f$ -J_l^{-1}(d) \f$
   [[nodiscard]] Tangent minus(const SO3& x, Jacobian* J_d_y = nullptr,

@@ -232,6 +232,8 @@ requires Manifold<detail::ResultOf<F, X>>
 
 /// Checks that x's plus and minus are consistent:
 /// \f$ (x \oplus d) \ominus x = d \f$, \f$ x \oplus (y \ominus x) = y \f$ for
+/// @param[in] x the point of the manifold
+/// @param[in] d a tangent step
 /// \f$ y = x \oplus d \f$, and \f$ x \ominus x = 0 \f$. d must lie inside the
 /// region where minus inverts plus (angles below π).
 /// @param[in] tol bound on the normalised errors \f$ \max|a - b| / (1 + \max|b|) \f$

@@ -73,6 +73,10 @@ void check_declared_structure(const Eigen::MatrixBase<Derived>& J, double tol,
 /// the numeric \f$ \partial f / \partial x \f$ of `predict` through the
 /// state's plus / minus, the prediction finite, and `noise(x, u, dt)`
 /// finite, symmetric and PSD.
+/// @param[in] model the motion model
+/// @param[in] x the state at which it is checked
+/// @param[in] u the control
+/// @param[in] dt_s the time step (s)
 /// @param[in] tol Jacobian and covariance tolerance (see check_jacobian, check_covariance)
 /// @param[in] step finite-difference step
 template <MotionModel M>
@@ -128,6 +132,8 @@ template <MotionModel M>
 /// numeric \f$ \partial h / \partial x \f$ of `predict` (outputs differenced
 /// with the Measurement's minus, so angles wrap), and the noise — `noise(x)`
 /// when the model has it, else `noise()` — finite, symmetric and PSD.
+/// @param[in] model the measurement model
+/// @param[in] x the state at which it is checked
 /// @param[in] tol Jacobian and covariance tolerance
 /// @param[in] step finite-difference step
 template <class H>

@@ -98,6 +98,7 @@ struct VioFrameResult {
 class VioEstimator {
  public:
   /// @param[in] camera intrinsics, distortion and extrinsic (T_BS)
+  /// @param[in] o the estimator's options
   VioEstimator(const PinholeRadtan& camera, const VioEstimatorOptions& o = {}) : cam_(camera), o_(o) {
     w_.T_bc = RigidPose{camera.T_BS.translation(), SO3d(Eigen::Quaterniond(camera.T_BS.rotation()).normalized())};
     w_.gravity_w = Eigen::Vector3d(0, 0, -o.static_init.gravity_mps2);

@@ -99,6 +99,11 @@ struct PnpResult {
 /// \f$ T_{wc}\,\mathrm{Exp}(\tau) \f$, \f$ \partial q / \partial\tau = [-I,\; [q]_\times] \f$
 /// and \f$ \partial q / \partial p_w = R_{wc}^\top \f$, each times
 /// \f$ \partial\pi/\partial q = [1/z, 0, -x/z^2;\; 0, 1/z, -y/z^2] \f$.
+/// @param[in] T_w_c the camera pose, p_w = T_w_c p_c
+/// @param[in] p_w the point in the world
+/// @param[in] m its normalised observation
+/// @param[out] J_pose if not null, \f$ \partial r / \partial\tau \f$ (2x6)
+/// @param[out] J_point if not null, \f$ \partial r / \partial p_w \f$ (2x3)
 /// Not validated (hot path); the caller keeps q in front of the camera.
 /// @param[out] depth if not null, z of q
 inline Eigen::Vector2d reprojection_residual(const SE3d& T_w_c, const Eigen::Vector3d& p_w,

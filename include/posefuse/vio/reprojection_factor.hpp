@@ -91,7 +91,7 @@ class ReprojectionFactor {
   }
 
   /// The whitened residual r and, for each pointer given, its Jacobian.
-  /// @param[in] Ti anchor keyframe pose, Tj observing keyframe pose, T_bc extrinsic
+  /// @param[in] Ti, Tj, T_bc anchor keyframe pose, observing keyframe pose, extrinsic
   /// @param[in] inv_depth λ in the anchor camera (> 0 for a point in front)
   /// @param[out] J_i, J_j, J_bc, J_lambda the Jacobians of the file comment, or null
   /// The residual is finite only for a point off the observer's z = 0 plane;

@@ -48,6 +48,7 @@ struct StaticInitResult {
 };
 
 /// Static start from the samples with stamps in [t_end - duration, t_end].
+/// @param[in] o the rest test's settings and g
 /// @param[in] samples time-ordered IMU samples
 /// @param[in] t_end_ns the stamp the state is for (the first frame)
 template <class Lazy = void>

@@ -72,6 +72,7 @@ struct Triangulation {
 
 /// Triangulates one point from its normalised observations in posed views
 /// (see the file comment).
+/// @param[in] o depth and parallax limits
 /// @param[in] T_w_c camera poses, p_w = T_w_c p_c
 /// @param[in] m the point's normalised observation in each view, same count
 /// @throws posefuse::invalid_argument on mismatched lengths or non-finite observations

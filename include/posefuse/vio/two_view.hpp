@@ -253,6 +253,7 @@ inline void refine_two_view(Eigen::Matrix3d& R, Eigen::Vector3d& t, std::span<co
 }  // namespace detail
 
 /// Relative pose of two views (see the file comment).
+/// @param[in] o RANSAC and refinement settings
 /// @param[in] m1 normalised coordinates in camera 1
 /// @param[in] m2 the same points' normalised coordinates in camera 2, same count
 /// @throws posefuse::invalid_argument on mismatched lengths, non-finite input or
