@@ -436,7 +436,7 @@ class ImuFactor:
 def align_visual_inertial(T_c0_c: _Array, T_b_c: _Array, preintegrations: List[Preintegration],
                           gravity_norm: float = 9.81, min_accel_std: float = 0.25,
                           max_gravity_norm_error: float = 1.0, refinement_iterations: int = 4) -> Dict[str, object]:
-    """VINS-Mono's visual-inertial alignment of 4 to 8 keyframes: status, ok, scale, gravity_c0, gyro_bias,
+    """VINS-Mono's visual-inertial alignment of 4 or more keyframes: status, ok, scale, gravity_c0, gyro_bias,
     velocity_c0, R_w_c0, T_w_b, velocity_w, accel_std, gravity_norm_unrefined, preintegrations (copies)."""
 
 # ---- filters -------------------------------------------------------------------------
