@@ -45,13 +45,13 @@ PoseGraphOptions options(const std::string& method, int max_iterations, double f
   if (method == "lm") o.levenberg_marquardt = true;
   else if (method == "gn") o.levenberg_marquardt = false;
   else throw py::value_error("method must be 'lm' (Levenberg-Marquardt) or 'gn' (Gauss-Newton), got '" + method + "'");
-  if (max_iterations < 1) throw py::value_error("max_iterations must be >= 1, got " + std::to_string(max_iterations));
   o.max_iterations = max_iterations;
   o.function_tolerance = function_tolerance;
   o.gradient_tolerance = gradient_tolerance;
   o.parameter_tolerance = parameter_tolerance;
   o.initial_lambda = initial_lambda;
   o.planar_fast_path = planar_fast_path;
+  o.validate();  // the C++ message naming the option, before the graph is looked at
   return o;
 }
 
@@ -330,8 +330,9 @@ constexpr const char* kOptimizeDoc =
     "block sparse Cholesky); when no node is fixed the first is held. Options as the C++ PoseGraphOptions: "
     "max_iterations (linear solves), function_tolerance (relative cost decrease), gradient_tolerance (largest "
     "gradient entry), parameter_tolerance (step relative to the state), initial_lambda (LM damping). Returns a "
-    "PoseGraphSummary; the graph's poses are updated. Raises ValueError when the graph is empty or disconnected "
-    "from every fixed node (C++ message).";
+    "PoseGraphSummary; the graph's poses are updated. Raises ValueError naming the option when max_iterations < 1 "
+    "or a tolerance or initial_lambda is NaN, infinite or negative, and when the graph is empty or disconnected "
+    "from every fixed node (C++ messages).";
 
 }  // namespace
 
@@ -567,7 +568,8 @@ void bind_graph(py::module_& m) {
         "robust loss. File errors raise with the C++ 'file:line: reason' text.");
   m.def("write_g2o", &write_g2o, py::arg("path"), py::arg("graph"),
         "Writes a graph as a g2o file (a planar PoseGraph4Dof as 2-D, a PoseGraphSE3 as 3-D): vertices, FIX, edges, "
-        "numbers as the shortest text that reads back exactly. Robust losses are not written.");
+        "numbers as the shortest text that reads back exactly. Robust losses are not written. A graph without nodes "
+        "raises ValueError and writes nothing (read_g2o refuses a file without vertices).");
 }
 
 }  // namespace posefuse::python

@@ -72,10 +72,17 @@ TrajectoryObject from_arrays(const py::object& stamps_obj, const py::object& pos
       check_shape(quaternions, {n, 4}, "quaternions", "(N, 4) (w, x, y, z) with N = len(stamps)");
       const auto q = quaternions.unchecked<2>();
       for (py::ssize_t k = 0; k < n; ++k) {
-        Eigen::Quaterniond qk(q(k, 0), q(k, 1), q(k, 2), q(k, 3));
-        if (!std::isfinite(qk.norm())) continue;  // validate() names the pose below
-        if (std::abs(qk.norm() - 1.0) > kQuaternionTolerance)
-          throw py::value_error("quaternions[" + std::to_string(k) + "] has norm " + std::to_string(qk.norm()) +
+        const Eigen::Quaterniond qk(q(k, 0), q(k, 1), q(k, 2), q(k, 3));
+        const std::string row = "quaternions[" + std::to_string(k) + "]";
+        if (!qk.coeffs().allFinite())
+          throw py::value_error(row + " = (" + apps::shortest(qk.w()) + ", " + apps::shortest(qk.x()) + ", " +
+                                apps::shortest(qk.y()) + ", " + apps::shortest(qk.z()) +
+                                ") (w, x, y, z) is not finite");
+        const double norm = qk.norm();
+        if (norm == 0.0) throw py::value_error(row + " is zero: a zero quaternion is no rotation");
+        if (!(std::abs(norm - 1.0) <= kQuaternionTolerance))
+          throw py::value_error(row + " has norm " +
+                                apps::shortest(std::isfinite(norm) ? norm : qk.coeffs().stableNorm()) +
                                 ", not 1 (within 1e-3)");
         traj.poses[static_cast<std::size_t>(k)].linear() = qk.normalized().toRotationMatrix();
       }
@@ -90,7 +97,7 @@ TrajectoryObject from_arrays(const py::object& stamps_obj, const py::object& pos
     const double residual = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
     if (residual > kRotationTolerance)
       throw py::value_error("poses[" + std::to_string(k) + "]: rotation is not orthonormal: max |R^T R - I| = " +
-                            std::to_string(residual) + " (tolerance 1e-6)");
+                            apps::shortest(residual) + " (tolerance 1e-6)");
     if (R.determinant() < 0.0)
       throw py::value_error("poses[" + std::to_string(k) + "]: rotation is a reflection (determinant < 0)");
   }
@@ -163,9 +170,10 @@ Build one from arrays, or read one with read_trajectory():
 
 Inputs are converted to float64 (lists and other dtypes are accepted). Stamps
 (s) must be finite and strictly increasing, poses finite with orthonormal
-rotations (ValueError with the C++ library's message otherwise). Quaternions
-are in the order (w, x, y, z), as evo's orientations_quat_wxyz; TUM files
-store them (x, y, z, w), which read_trajectory handles.
+rotations, quaternions finite with a norm within 1e-3 of 1 (they are then
+normalised); ValueError naming the row otherwise. Quaternions are in the
+order (w, x, y, z), as evo's orientations_quat_wxyz; TUM files store them
+(x, y, z, w), which read_trajectory handles.
 
 stamps, positions and poses are read-only views on the trajectory's memory
 (no copy); quaternions is computed on each access.)doc")

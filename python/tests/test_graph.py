@@ -322,6 +322,69 @@ def test_bad_input_raises_with_the_cpp_messages(tmp_path):
         G.add_node(0, np.eye(3))
 
 
+def _small_graphs():
+    g = pf.PoseGraph4Dof()
+    g.add_nodes([0, 1, 2], [[0.0, 0.0, 0.0], [1.1, 0.1, 0.05], [2.0, -0.1, 0.0]])
+    g.add_edges([0, 1], [1, 2], [[1.0, 0.0], [1.0, 0.0]], [0.0, 0.0], np.eye(3))
+    G = pf.PoseGraphSE3()
+    T = np.tile(np.eye(4), (3, 1, 1))
+    T[:, 0, 3] = [0.0, 1.1, 2.0]
+    G.add_nodes([0, 1, 2], T)
+    Z = np.eye(4)
+    Z[0, 3] = 1.0
+    G.add_edges([0, 1], [1, 2], np.stack([Z, Z]), np.eye(6))
+    return g, G
+
+
+@pytest.mark.parametrize("option", ["function_tolerance", "gradient_tolerance", "parameter_tolerance",
+                                    "initial_lambda"])
+@pytest.mark.parametrize("value", [math.nan, -1e-5, math.inf, -math.inf])
+def test_optimize_refuses_nan_negative_and_infinite_options_naming_them(option, value):
+    for g in _small_graphs():
+        before = g.poses.copy()
+        with pytest.raises(ValueError, match="PoseGraphOptions: %s must be finite and >= 0, got " % option) as e:
+            g.optimize(**{option: value})
+        assert str(e.value).endswith({math.nan: "nan", -1e-5: "-1e-05", math.inf: "inf", -math.inf: "-inf"}[value])
+        np.testing.assert_array_equal(g.poses, before)  # refused before any work
+        for method in ("lm", "gn"):
+            with pytest.raises(ValueError, match=option):
+                g.optimize(method=method, **{option: value})
+    # 0 is allowed (no damping / that test off) and still converges.
+    for g in _small_graphs():
+        s = g.optimize(initial_lambda=0.0, function_tolerance=0.0)
+        assert s.final_cost < 1e-20
+
+
+def test_optimize_refuses_max_iterations_below_one():
+    for g in _small_graphs():
+        with pytest.raises(ValueError, match="PoseGraphOptions: max_iterations must be >= 1, got 0"):
+            g.optimize(max_iterations=0)
+        with pytest.raises(ValueError, match="max_iterations must be >= 1, got -3"):
+            g.optimize(max_iterations=-3)
+
+
+def test_write_g2o_refuses_an_empty_graph_and_what_it_writes_reads_back(tmp_path):
+    for empty, tag in ((pf.PoseGraph4Dof(), "VERTEX_SE2"), (pf.PoseGraphSE3(), "VERTEX_SE3:QUAT")):
+        f = tmp_path / "empty.g2o"
+        with pytest.raises(ValueError, match="the graph has no vertex, and a g2o file needs a %s line" % tag):
+            pf.write_g2o(f, empty)
+        assert not f.exists()  # nothing written
+    # One node and no edge: written, and read back as the same graph.
+    g = pf.PoseGraph4Dof()
+    g.add_node(4, [1.5, -2.0, 0.25])
+    G = pf.PoseGraphSE3()
+    T = np.eye(4)
+    T[:3, 3] = [1.0, 2.0, 3.0]
+    G.add_node(9, T)
+    for graph in (g, G):
+        f = tmp_path / "one.g2o"
+        pf.write_g2o(f, graph)
+        back = pf.read_g2o(f)
+        assert type(back) is type(graph) and back.num_nodes == 1 and back.num_edges == 0
+        np.testing.assert_array_equal(back.ids, graph.ids)
+        np.testing.assert_allclose(back.poses, graph.poses, rtol=0, atol=1e-15)
+
+
 def test_bad_g2o_files_raise_file_errors_with_file_and_line(tmp_path):
     f = tmp_path / "bad.g2o"
     f.write_text("VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\nEDGE_SE2 0 1 1 0 0 1 0 0 1 0\n")

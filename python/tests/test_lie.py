@@ -350,6 +350,35 @@ def test_bad_input_raises_with_the_cpp_messages():
         pf.SO3.exp(np.zeros(3), jacobian="yes please")
 
 
+@pytest.mark.parametrize("k", [30, 100, 500, 996, 1022])
+def test_so3_and_se3_exp_of_huge_finite_rotation_vectors_are_rotations(k):
+    # |phi| = 3 * 2^k exactly (axis (1, 2, 2) / 3); 3 * 2^1022 is near the largest double.
+    u = np.array([1.0, 2.0, 2.0]) / 3.0
+    phi = math.ldexp(1.0, k) * np.array([1.0, 2.0, 2.0])
+    th = 3.0 * math.ldexp(1.0, k)
+    R, J = pf.SO3.exp(phi, jacobian=True)
+    assert np.isfinite(R).all() and np.isfinite(J).all()
+    np.testing.assert_allclose(R.T @ R, np.eye(3), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(R @ u, u, rtol=0, atol=1e-15)  # about u ...
+    assert abs(np.trace(R) - (1.0 + 2.0 * math.cos(th))) < 4e-15  # ... by th (cos reduces th exactly)
+    np.testing.assert_allclose(J @ u, u, rtol=0, atol=1e-15)  # J_r(phi) phi = phi
+    rho = np.array([0.3, -1.5, 2.0])
+    T, JT = pf.SE3.exp(np.concatenate([rho, phi]), jacobian=True)
+    assert np.isfinite(T).all() and np.isfinite(JT).all()
+    np.testing.assert_array_equal(T[:3, :3], R)
+    # t = J_l(phi) rho = u u^T rho + O(1/|phi|): the part of rho along the axis.
+    np.testing.assert_allclose(T[:3, 3], u * (u @ rho), rtol=0, atol=1e-14)
+
+
+def test_exp_of_a_rotation_vector_of_norm_1e300_is_a_rotation():
+    phi = np.array([0.6e300, -0.8e300, 0.0])
+    for R in (pf.SO3.exp(phi), pf.SE3.exp(np.concatenate([[1.0, 2.0, 3.0], phi]))[:3, :3]):
+        assert np.isfinite(R).all()
+        np.testing.assert_allclose(R.T @ R, np.eye(3), rtol=0, atol=1e-15)
+        assert abs(np.linalg.det(R) - 1.0) < 1e-15
+        np.testing.assert_allclose(R @ [0.6, -0.8, 0.0], [0.6, -0.8, 0.0], rtol=0, atol=1e-15)
+
+
 def test_tangents_and_points_are_not_validated_nan_in_nan_out():
     assert np.isnan(pf.SO3.exp([np.nan, 0.0, 0.0])).all()
     assert np.isnan(pf.SE3.act(np.eye(4), [np.nan, 0.0, 0.0])[0])

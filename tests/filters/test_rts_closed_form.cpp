@@ -15,6 +15,7 @@
 #include <posefuse/models/constant_velocity.hpp>
 #include <posefuse/models/planar_displacement.hpp>
 #include <posefuse/models/position.hpp>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -177,4 +178,114 @@ TEST_CASE("rts_smooth: seed 000's x' = x + u, z = x equals the information-form 
   }
   posefuse::Ekf<posefuse::PlanarDisplacement<double>, posefuse::PositionFix<2>> ekf(motion, fix);
   compare(ekf, p, u, dt);
+}
+
+namespace {
+
+/// A recorded run of K steps on N states with random positive definite
+/// covariances and random transitions (the predictions consistent with the
+/// filtered beliefs: Pbar = F P F^T + Q).
+template <int N>
+std::vector<posefuse::SmootherStep<Eigen::Matrix<double, N, 1>>> random_run(int K, unsigned seed) {
+  using Mat = Eigen::Matrix<double, N, N>;
+  using Vec = Eigen::Matrix<double, N, 1>;
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n(0.0, 1.0);
+  const auto mat = [&] {
+    Mat M;
+    for (int i = 0; i < N; ++i)
+      for (int j = 0; j < N; ++j) M(i, j) = n(rng);
+    return M;
+  };
+  const auto vec = [&] {
+    Vec v;
+    for (int i = 0; i < N; ++i) v(i) = n(rng);
+    return v;
+  };
+  const auto spd = [&](double floor) {
+    const Mat M = mat();
+    const Mat P = M * M.transpose() + floor * Mat::Identity();
+    return Mat(0.5 * (P + P.transpose()));  // exactly symmetric
+  };
+  std::vector<posefuse::SmootherStep<Vec>> run(static_cast<std::size_t>(K));
+  for (int k = 0; k < K; ++k) {
+    auto& s = run[std::size_t(k)];
+    if (k > 0) {
+      const auto& prev = run[std::size_t(k - 1)];
+      s.F = Mat::Identity() + 0.3 * mat();
+      s.predicted_mean = s.F * prev.filtered_mean;
+      s.predicted_cov = s.F * prev.filtered_cov * s.F.transpose() + spd(0.05);
+    } else {
+      s.predicted_mean = vec();
+      s.predicted_cov = spd(0.5);
+    }
+    s.filtered_mean = s.predicted_mean + 0.1 * vec();
+    s.filtered_cov = spd(0.2);
+  }
+  return run;
+}
+
+/// The textbook backward pass with a dynamic-size Cholesky solve.
+template <int N>
+std::vector<VectorXd> reference_rts(const std::vector<posefuse::SmootherStep<Eigen::Matrix<double, N, 1>>>& run,
+                                    std::vector<MatrixXd>& cov) {
+  std::vector<VectorXd> mean(run.size());
+  cov.assign(run.size(), MatrixXd());
+  VectorXd xs = run.back().filtered_mean;
+  MatrixXd Ps = run.back().filtered_cov;
+  mean.back() = xs;
+  cov.back() = Ps;
+  for (std::size_t k = run.size() - 1; k-- > 0;) {
+    const MatrixXd Pbar = run[k + 1].predicted_cov;
+    const MatrixXd C = Pbar.llt().solve(MatrixXd(run[k + 1].F * run[k].filtered_cov)).transpose();
+    xs = run[k].filtered_mean + C * (xs - run[k + 1].predicted_mean);
+    Ps = run[k].filtered_cov + C * (Ps - Pbar) * C.transpose();
+    mean[k] = xs;
+    cov[k] = Ps;
+  }
+  return mean;
+}
+
+template <int N>
+void check_against_reference_and_refusals() {
+  INFO(N << " states");
+  using Mat = Eigen::Matrix<double, N, N>;
+  auto run = random_run<N>(6, 4000u + unsigned(N));
+  const auto s = posefuse::rts_smooth(run);
+  std::vector<MatrixXd> cov;
+  const std::vector<VectorXd> mean = reference_rts<N>(run, cov);
+  for (std::size_t k = 0; k < run.size(); ++k) {
+    CHECK((VectorXd(s[k].mean) - mean[k]).cwiseAbs().maxCoeff() <= 1e-12 * (1 + mean[k].cwiseAbs().maxCoeff()));
+    CHECK((MatrixXd(s[k].cov) - cov[k]).cwiseAbs().maxCoeff() <= 1e-12 * (1 + cov[k].cwiseAbs().maxCoeff()));
+    CHECK(s[k].cov == s[k].cov.transpose());  // exactly symmetric
+  }
+  // A predicted covariance that is indefinite, singular, zero or not finite
+  // is refused, naming its step.
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  Mat indefinite = Mat::Identity();
+  indefinite(N - 1, N - 1) = -1e-3;
+  const Eigen::Matrix<double, N, 1> v = Eigen::Matrix<double, N, 1>::LinSpaced(1.0, 2.0);
+  Mat rank_one = v * v.transpose();  // singular for N >= 2
+  if (N == 1) rank_one.setZero();
+  Mat with_nan = run[2].predicted_cov, with_inf = run[2].predicted_cov;
+  with_nan(N - 1, 0) = nan;
+  with_inf(N - 1, N - 1) = inf;
+  for (const Mat& bad : {indefinite, rank_one, Mat(Mat::Zero()), with_nan, with_inf}) {
+    auto broken = run;
+    broken[2].predicted_cov = bad;
+    CHECK_THROWS_WITH(posefuse::rts_smooth(broken),
+                      "rts_smooth: predicted covariance 2 is not positive definite");
+  }
+}
+
+}  // namespace
+
+TEST_CASE("rts_smooth: 1 to 5 states equal a textbook Cholesky pass; a predicted covariance that is not "
+          "positive definite or not finite is refused naming its step",
+          "[filters][rts]") {
+  check_against_reference_and_refusals<1>();
+  check_against_reference_and_refusals<2>();
+  check_against_reference_and_refusals<3>();
+  check_against_reference_and_refusals<4>();
+  check_against_reference_and_refusals<5>();  // beyond the closed-form blocks: Cholesky
 }

@@ -9,8 +9,11 @@
 #include <fstream>
 #include <string>
 
+#include <limits>
+
 #include <posefuse/graph/g2o_graph.hpp>
 #include <posefuse/io/g2o.hpp>
+#include <posefuse/io/g2o_se3.hpp>
 
 #include "support/data_path.hpp"
 #include "support/run_program.hpp"
@@ -147,6 +150,90 @@ TEST_CASE("g2o: a planar graph gives the hand-computed optimum", "[graph][g2o]")
   CHECK(s.final_cost == Approx(3.0).epsilon(1e-12));
   const G2oGraph2d out = with_graph_poses(read_g2o_2d(p), graph);
   CHECK(out.vertices[1].x == graph.pose(1).p.x());
+}
+
+TEST_CASE("g2o: a graph without vertices is not written (the reader refuses such a file); one without edges "
+          "reads back", "[graph][g2o]") {
+  TempDir dir("empty");
+  const auto p2 = dir.path() / "empty2.g2o";
+  const auto p3 = dir.path() / "empty3.g2o";
+  CHECK_THROWS_AS(write_g2o_2d(p2, G2oGraph2d{}), invalid_argument);
+  CHECK_THROWS_WITH(write_g2o_2d(p2, G2oGraph2d{}),
+                    Catch::Contains("write_g2o_2d: the graph has no vertex") && Catch::Contains(p2.string()));
+  CHECK_THROWS_WITH(write_g2o_3d(p3, G2oGraph3d{}),
+                    Catch::Contains("write_g2o_3d: the graph has no vertex") && Catch::Contains(p3.string()));
+  CHECK_FALSE(std::filesystem::exists(p2));
+  CHECK_FALSE(std::filesystem::exists(p3));
+  // Vertices (one fixed) and no edge: what is written reads back.
+  G2oGraph2d g;
+  g.vertices.push_back({5, 1.5, -2.0, 0.25, 0});
+  g.fixed.push_back(5);
+  write_g2o_2d(p2, g);
+  const G2oGraph2d h = read_g2o_2d(p2);
+  REQUIRE(h.vertices.size() == 1);
+  CHECK(h.vertices[0].id == 5);
+  CHECK(h.vertices[0].theta == 0.25);
+  CHECK(h.fixed == g.fixed);
+  CHECK(h.edges.empty());
+  G2oGraph3d G;
+  G.vertices.push_back({9, Eigen::Vector3d(1, 2, 3), Eigen::Quaterniond::Identity(), 0});
+  write_g2o_3d(p3, G);
+  const G2oGraph3d H = read_g2o_3d(p3);
+  REQUIRE(H.vertices.size() == 1);
+  CHECK(H.vertices[0].t == G.vertices[0].t);
+}
+
+TEST_CASE("PoseGraphOptions: NaN, infinite or negative tolerances and damping, and max_iterations < 1, are refused "
+          "naming the option, before any work", "[graph][g2o][validation]") {
+  TempDir dir("options");
+  const auto p = write_text(dir, "two.g2o",
+                            "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 5 5 1\n"
+                            "EDGE_SE2 0 1 1 0 0.2 1 0 0 1 0 1\n");
+  PoseGraph4Dof graph = pose_graph_from_g2o(read_g2o_2d(p));
+  PoseGraphSE3 graph3;
+  graph3.add_node(0, SE3d());
+  graph3.add_node(1, SE3d(Eigen::Vector3d(5, 5, 0), SO3d()));
+  EdgeSE3 e3;
+  e3.from = 0;
+  e3.to = 1;
+  e3.measurement = SE3d(Eigen::Vector3d(1, 0, 0), SO3d());
+  graph3.add_edge(e3);
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  using Field = double PoseGraphOptions::*;
+  const std::pair<Field, const char*> fields[] = {{&PoseGraphOptions::function_tolerance, "function_tolerance"},
+                                                  {&PoseGraphOptions::gradient_tolerance, "gradient_tolerance"},
+                                                  {&PoseGraphOptions::parameter_tolerance, "parameter_tolerance"},
+                                                  {&PoseGraphOptions::initial_lambda, "initial_lambda"}};
+  for (const auto& [field, name] : fields) {
+    for (const double bad : {nan, -1e-5, inf, -inf}) {
+      for (const bool lm : {true, false}) {
+        PoseGraphOptions o;
+        o.levenberg_marquardt = lm;
+        o.*field = bad;
+        INFO(name << " = " << bad << (lm ? " (lm)" : " (gn)"));
+        CHECK_THROWS_WITH(o.validate(), Catch::Contains(std::string("PoseGraphOptions: ") + name +
+                                                        " must be finite and >= 0, got "));
+        CHECK_THROWS_AS(graph.optimize(o), invalid_argument);
+        CHECK_THROWS_AS(graph3.optimize(o), invalid_argument);
+        CHECK(graph.pose(1).p.x() == 5.0);  // untouched
+        CHECK(graph3.pose(1).translation().x() == 5.0);
+      }
+    }
+  }
+  PoseGraphOptions o;
+  o.initial_lambda = nan;
+  CHECK_THROWS_WITH(o.validate(), Catch::EndsWith("got nan"));
+  o.initial_lambda = -1e-5;
+  CHECK_THROWS_WITH(o.validate(), Catch::EndsWith("got -1e-05"));
+  o = PoseGraphOptions{};
+  o.max_iterations = 0;
+  CHECK_THROWS_WITH(graph.optimize(o), "PoseGraphOptions: max_iterations must be >= 1, got 0");
+  // Zero tolerances and zero damping are settings, not errors.
+  o = PoseGraphOptions{};
+  o.function_tolerance = o.gradient_tolerance = o.parameter_tolerance = o.initial_lambda = 0.0;
+  CHECK_NOTHROW(o.validate());
+  CHECK(graph.optimize(o).final_cost < 1e-20);
+  CHECK(graph3.optimize(o).final_cost < 1e-20);
 }
 
 TEST_CASE("g2o: MIT Killian Court converges from the rotation-first start", "[graph][g2o][data]") {

@@ -191,6 +191,40 @@ TEST_CASE("SE3: near pi and at pi", "[lie][se3]") {
   CHECK((SE3<double>::exp(l).translation() - g.translation()).norm() < 1e-15);
 }
 
+TEST_CASE("SE3: Exp and its Jacobian at large finite angles: long double below 3e9 rad, finite beyond",
+          "[lie][se3]") {
+  using L = long double;
+  using V3 = Eigen::Vector3d;
+  const V3 rho(0.3, -1.5, 2.0);
+  // |phi| = 3 * 2^k exactly (axis (1, 2, 2) / 3).
+  if constexpr (std::numeric_limits<L>::digits > 53) {
+    for (const int k : {25, 29}) {
+      const V3 phi = std::ldexp(1.0, k) * V3(1, 2, 2);
+      const V6 tau = tangent(rho.x(), rho.y(), rho.z(), phi.x(), phi.y(), phi.z());
+      INFO("|phi| = 3 * 2^" << k);
+      Eigen::Matrix<double, 6, 6> J;
+      Eigen::Matrix<L, 6, 6> J_ref;
+      const SE3<double> g = SE3<double>::exp(tau, &J);
+      const SE3<L> ref = SE3<L>::exp(tau.cast<L>(), &J_ref);
+      CHECK(double((g.matrix().cast<L>() - ref.matrix()).cwiseAbs().maxCoeff()) < 4e-15);
+      CHECK(double((J.cast<L>() - J_ref).cwiseAbs().maxCoeff()) < 4e-15);
+    }
+  }
+  const V3 u = V3(1, 2, 2) / 3.0;
+  for (const int k : {100, 996, 1022}) {
+    const V3 phi = std::ldexp(1.0, k) * V3(1, 2, 2);
+    INFO("|phi| = 3 * 2^" << k);
+    Eigen::Matrix<double, 6, 6> J;
+    const SE3<double> g = SE3<double>::exp(tangent(rho.x(), rho.y(), rho.z(), phi.x(), phi.y(), phi.z()), &J);
+    REQUIRE(g.matrix().allFinite());
+    REQUIRE(J.allFinite());
+    // t = J_l(phi) rho, and J_l(phi) = u u^T + O(1/|phi|): the part of rho along the axis.
+    CHECK((g.translation() - u * u.dot(rho)).cwiseAbs().maxCoeff() < 1e-14);
+    CHECK((g.so3().matrix() * u - u).cwiseAbs().maxCoeff() < 1e-15);
+    CHECK((J.bottomRightCorner<3, 3>() * u - u).cwiseAbs().maxCoeff() < 1e-15);
+  }
+}
+
 TEMPLATE_TEST_CASE("SE3: conversions to and from Eigen isometries", "[lie][se3]", float, double) {
   using T = TestType;
   using V = Eigen::Matrix<T, 3, 1>;

@@ -156,6 +156,52 @@ TEST_CASE("SO3: near pi and at pi", "[lie][so3]") {
   CHECK(SO3<double>::right_jacobian_inverse(back).allFinite());
 }
 
+TEST_CASE("SO3: Exp and J_r of large finite angles: long double below 3e9 rad, finite up to the largest double",
+          "[lie][so3]") {
+  using V = Eigen::Vector3d;
+  using L = long double;
+  // Axis (1, 2, 2) / 3 scaled by 2^k: |phi| = 3 * 2^k exactly, also where
+  // |phi|^2 overflows (the norm is then scaled by the largest entry, 2^(k+1)).
+  const V u = V(1, 2, 2) / 3.0;
+  // Above detail::large_angle (6.7e7 rad) double takes the axis form; the
+  // long-double closed form is still the ordinary one below 3e9 rad (x87).
+  if constexpr (std::numeric_limits<L>::digits > 53) {
+    for (const int k : {25, 27, 29}) {
+      const V phi = std::ldexp(1.0, k) * V(1, 2, 2);
+      INFO("|phi| = 3 * 2^" << k);
+      REQUIRE(phi.norm() > posefuse::detail::large_angle<double>());
+      REQUIRE(L(phi.norm()) < posefuse::detail::large_angle<L>());
+      Eigen::Matrix3d J;
+      Eigen::Matrix<L, 3, 3> J_ref;
+      const SO3<double> g = SO3<double>::exp(phi, &J);
+      const SO3<L> ref = SO3<L>::exp(phi.cast<L>(), &J_ref);
+      CHECK(double((g.matrix().cast<L>() - ref.matrix()).cwiseAbs().maxCoeff()) < 4e-16);
+      CHECK(double((J.cast<L>() - J_ref).cwiseAbs().maxCoeff()) < 4e-16);
+    }
+  }
+  for (const int k : {60, 500, 996, 1022}) {  // 3 * 2^1022 is above DBL_MAX / 2: |phi|^2 and 2 |phi| overflow
+    const V phi = std::ldexp(1.0, k) * V(1, 2, 2);
+    const double th = 3.0 * std::ldexp(1.0, k);
+    INFO("|phi| = 3 * 2^" << k);
+    REQUIRE(std::isfinite(th));
+    Eigen::Matrix3d J;
+    const SO3<double> g = SO3<double>::exp(phi, &J);
+    const Eigen::Matrix3d R = g.matrix();
+    REQUIRE(R.allFinite());
+    CHECK((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-15);
+    // A rotation about u (R u = u) by th: trace R = 1 + 2 cos th (cos reduces th exactly).
+    CHECK((R * u - u).cwiseAbs().maxCoeff() < 1e-15);
+    CHECK(std::abs(R.trace() - (1.0 + 2.0 * std::cos(th))) < 4e-15);
+    // J_r(phi) phi = phi; away from 0 the rest of J_r is 1/th small: J_r = u u^T + O(1/th).
+    REQUIRE(J.allFinite());
+    CHECK((J * u - u).cwiseAbs().maxCoeff() < 1e-15);
+    CHECK((J - u * u.transpose()).cwiseAbs().maxCoeff() < 1e-15);
+  }
+  // Non-finite stays non-finite.
+  CHECK_FALSE(SO3<double>::exp(V(std::numeric_limits<double>::infinity(), 0, 0)).matrix().allFinite());
+  CHECK_FALSE(SO3<double>::exp(V(std::numeric_limits<double>::quiet_NaN(), 0, 0)).matrix().allFinite());
+}
+
 TEMPLATE_TEST_CASE("SO3: quaternion and matrix constructors normalise and validate", "[lie][so3]",
                    float, double) {
   using T = TestType;

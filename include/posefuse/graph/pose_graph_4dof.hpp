@@ -245,7 +245,7 @@ class PoseGraph4Dof {
   /// once per call). LM adapts \f$ \lambda \f$ by the gain ratio (Nielsen's
   /// rule); a step is taken only when it lowers the cost. When no node is
   /// fixed, the first is held fixed. Uses the graph's own workspace.
-  /// @throws posefuse::invalid_argument as validate()
+  /// @throws posefuse::invalid_argument as validate() or options.validate() (PoseGraphOptions)
   PoseGraphSummary optimize(const PoseGraphOptions& options = {}) { return optimize(options, workspace_); }
 
   /// optimize() with the caller's buffers (see PoseGraphWorkspace): the same

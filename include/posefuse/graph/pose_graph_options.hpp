@@ -7,8 +7,13 @@
 /// (graph/edge_error_4dof.hpp, graph/robust_loss.hpp); Ceres reports
 /// \f$ F/2 \f$.
 
+#include <cmath>
+#include <cstdio>
 #include <functional>
+#include <string>
 #include <string_view>
+
+#include <posefuse/core/error.hpp>
 
 namespace posefuse {
 
@@ -60,6 +65,25 @@ struct PoseGraphOptions {
   /// terminal); it only observes: the iterations and the result are the
   /// same with or without it. Empty (the default): one test per iteration.
   std::function<void(const PoseGraphIteration&)> progress;
+
+  /// Checks the settings (optimize() calls it first): max_iterations >= 1,
+  /// every tolerance and initial_lambda finite and >= 0 (a NaN would make
+  /// every stopping test false, a negative one never true).
+  /// @throws posefuse::invalid_argument naming the first offending option
+  void validate() const {
+    if (max_iterations < 1)
+      throw invalid_argument("PoseGraphOptions: max_iterations must be >= 1, got " + std::to_string(max_iterations));
+    const auto check = [](double v, const char* name) {
+      if (std::isfinite(v) && v >= 0.0) return;
+      char text[32];
+      std::snprintf(text, sizeof text, "%g", v);
+      throw invalid_argument(std::string("PoseGraphOptions: ") + name + " must be finite and >= 0, got " + text);
+    };
+    check(function_tolerance, "function_tolerance");
+    check(gradient_tolerance, "gradient_tolerance");
+    check(parameter_tolerance, "parameter_tolerance");
+    check(initial_lambda, "initial_lambda");
+  }
 };
 
 /// What an optimisation did.

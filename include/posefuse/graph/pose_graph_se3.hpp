@@ -243,7 +243,7 @@ class PoseGraphSE3 {
   /// step is applied by pose_graph_plus. LM and its stopping rules are the
   /// 4-DoF graph's (PoseGraphOptions). When no node is fixed, the first is
   /// held fixed.
-  /// @throws posefuse::invalid_argument as validate()
+  /// @throws posefuse::invalid_argument as validate() or options.validate() (PoseGraphOptions)
   PoseGraphSummary optimize(const PoseGraphOptions& options = {}) { return optimize(options, workspace_); }
 
   /// optimize() with the caller's buffers (see PoseGraphSE3Workspace): the

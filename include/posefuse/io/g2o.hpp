@@ -215,11 +215,16 @@ template <class Lazy = void>
 
 /// Writes a g2o 2-D file: vertices, then `FIX` (when any), then edges;
 /// numbers as the shortest text that reads back exactly.
-/// @throws posefuse::io_error when the file cannot be written
+/// @throws posefuse::invalid_argument, before the file is created, for a
+///         graph without vertices (read_g2o_2d refuses a file with no
+///         VERTEX_SE2 line); posefuse::io_error when the file cannot be written
 template <class Lazy = void>
 void write_g2o_2d(const std::filesystem::path& file, const G2oGraph2d& g) {
   namespace io = detail::g2o_io;
   using detail::traj_io::format_number;
+  if (g.vertices.empty())
+    throw invalid_argument("write_g2o_2d: the graph has no vertex, and a g2o file needs a VERTEX_SE2 line (" +
+                           file.string() + " not written)");
   std::ofstream out = detail::traj_io::open_output(file);
   for (const G2oVertexSE2& v : g.vertices)
     out << "VERTEX_SE2 " << v.id << ' ' << format_number(v.x) << ' ' << format_number(v.y) << ' '

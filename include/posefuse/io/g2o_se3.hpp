@@ -178,10 +178,15 @@ template <class Lazy = void>
 
 /// Writes a g2o 3-D file: vertices, then `FIX` (when any), then edges;
 /// numbers as the shortest text that reads back exactly.
-/// @throws posefuse::io_error when the file cannot be written
+/// @throws posefuse::invalid_argument, before the file is created, for a
+///         graph without vertices (read_g2o_3d refuses a file with no
+///         VERTEX_SE3:QUAT line); posefuse::io_error when the file cannot be written
 template <class Lazy = void>
 void write_g2o_3d(const std::filesystem::path& file, const G2oGraph3d& g) {
   using detail::traj_io::format_number;
+  if (g.vertices.empty())
+    throw invalid_argument("write_g2o_3d: the graph has no vertex, and a g2o file needs a VERTEX_SE3:QUAT line (" +
+                           file.string() + " not written)");
   std::ofstream out = detail::traj_io::open_output(file);
   const auto pose = [&](const Eigen::Vector3d& t, const Eigen::Quaterniond& q) {
     out << ' ' << format_number(t.x()) << ' ' << format_number(t.y()) << ' ' << format_number(t.z()) << ' '

@@ -73,7 +73,8 @@ class SE3 {
   /// The identity motion.
   [[nodiscard]] static SE3 identity() noexcept { return SE3(); }
 
-  /// \f$ \mathrm{Exp}(\tau) = (J_l(\phi)\rho, \mathrm{Exp}(\phi)) \f$ (Solà eq 172, 174).
+  /// \f$ \mathrm{Exp}(\tau) = (J_l(\phi)\rho, \mathrm{Exp}(\phi)) \f$ (Solà eq 172, 174);
+  /// finite for every finite τ (large angles as SO3::exp). Not validated.
   /// @param[in] tau [ρ, φ]
   /// @param[out] J_g_tau if not null, \f$ J_r(\tau) \f$
   [[nodiscard]] static SE3 exp(const Tangent& tau, Jacobian* J_g_tau = nullptr) noexcept {
@@ -249,11 +250,27 @@ class SE3 {
   }
 
  private:
-  // Q(rho, phi) of Barfoot eq 7.86 (the file comment).
+  // Q(rho, phi) of Barfoot eq 7.86 (the file comment). Above
+  // detail::large_angle, with F = θ U (U = [φ/θ]x), the same sum with the
+  // powers of θ folded into the coefficients: c1 θ, c1 θ², c2 θ², c3 θ³.
   static typename SO3<T>::Matrix q_block(const Point& rho, const Point& phi) noexcept {
     using M3 = typename SO3<T>::Matrix;
-    const T th = phi.norm();
+    const T th = detail::overflow_safe_norm(phi);
     const M3 P = SO3<T>::hat(rho);
+    if (th > detail::large_angle<T>()) {
+      const M3 U = SO3<T>::hat(Point(phi / th));
+      const M3 UP = U * P;
+      const M3 PU = P * U;
+      const M3 UPU = UP * U;
+      const T s = std::sin(th);
+      const T h = std::sin(th / T(2)) / th;
+      const T c1_th = (th - s) / th / th;                                   // c1 θ
+      const T c1_th2 = T(1) - s / th;                                       // c1 θ²
+      const T c2_th2 = T(0.5) - T(2) * h * h;                               // c2 θ² = 1/2 - (1 - cos θ) / θ²
+      const T c3_th3 = (T(2) + std::cos(th)) / (T(2) * th) - T(1.5) * s / th / th;  // c3 θ³
+      return T(0.5) * P + c1_th * (UP + PU) + c1_th2 * UPU + c2_th2 * (U * UP + PU * U - T(3) * UPU) +
+             c3_th3 * (UPU * U + U * UPU);
+    }
     const M3 F = SO3<T>::hat(phi);
     const M3 FP = F * P;
     const M3 PF = P * F;

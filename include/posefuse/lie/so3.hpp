@@ -35,6 +35,21 @@
 
 namespace posefuse {
 
+namespace detail {
+/// \f$ |\phi| \f$ without overflow: `phi.norm()` (to the bit) whenever
+/// \f$ |\phi|^2 \f$ is finite, else the norm scaled by the largest
+/// \f$ |\phi_i| \f$ (finite for every finite φ; ∞ or NaN for a non-finite one).
+template <class Derived>
+[[nodiscard]] typename Derived::Scalar overflow_safe_norm(const Eigen::MatrixBase<Derived>& phi) noexcept {
+  using T = typename Derived::Scalar;
+  const T s2 = phi.squaredNorm();
+  if (s2 <= std::numeric_limits<T>::max()) return std::sqrt(s2);
+  const T m = phi.cwiseAbs().maxCoeff();
+  if (!(m <= std::numeric_limits<T>::max())) return std::sqrt(s2);  // an infinite or NaN entry
+  return m * (phi / m).norm();
+}
+}  // namespace detail
+
 /// A rotation of 3-D space: \f$ q = R\,p \f$.
 ///
 /// As an attitude, `SO3` is the orientation of a body frame in a world
@@ -99,11 +114,20 @@ class SO3 {
 
   /// \f$ \mathrm{Exp}(\phi) \f$, the rotation by θ = |φ| rad about φ/θ (see the file comment).
   /// @param[in] phi the rotation vector \f$ \phi \f$ (rad)
-  /// Not validated (hot path): a non-finite φ gives a non-finite rotation.
+  /// Every finite φ gives a rotation: above detail::large_angle (6.7e7 rad
+  /// in double) the quaternion is \f$ (\cos\tfrac{\theta}{2}, \sin\tfrac{\theta}{2}\,u) \f$
+  /// with the unit axis u and θ computed without overflow (the sine and
+  /// cosine reduce any finite angle exactly). Not validated (hot path): a
+  /// non-finite φ gives a non-finite rotation.
   /// @param[out] J_g_tau if not null, \f$ J_r(\phi) \f$
   [[nodiscard]] static SO3 exp(const Tangent& phi, Jacobian* J_g_tau = nullptr) noexcept {
-    const T th = phi.norm();
+    const T th = detail::overflow_safe_norm(phi);
     if (J_g_tau) *J_g_tau = right_jacobian(phi);
+    if (th > detail::large_angle<T>()) {
+      const Tangent u = phi / th;
+      const T s = std::sin(th / T(2));
+      return SO3(Quaternion(std::cos(th / T(2)), s * u.x(), s * u.y(), s * u.z()), Unchecked{});
+    }
     const T k = detail::sin_over_x(th / T(2)) / T(2);  // sin(θ/2) / θ
     return SO3(Quaternion(std::cos(th / T(2)), k * phi.x(), k * phi.y(), k * phi.z()), Unchecked{});
   }
@@ -203,9 +227,17 @@ class SO3 {
   /// \f$ \mathrm{Ad}_g = R \f$, so that \f$ g\,\mathrm{Exp}(\phi) = \mathrm{Exp}(R\phi)\,g \f$.
   [[nodiscard]] Jacobian adjoint() const noexcept { return matrix(); }
 
-  /// \f$ J_r(\phi) \f$ (Solà eq 143; see the file comment).
+  /// \f$ J_r(\phi) \f$ (Solà eq 143; see the file comment). Above
+  /// detail::large_angle, in the axis form
+  /// \f$ I - \tfrac{1 - \cos\theta}{\theta}[u]_\times + (1 - \tfrac{\sin\theta}{\theta})[u]_\times^2 \f$,
+  /// finite for every finite φ.
   [[nodiscard]] static Jacobian right_jacobian(const Tangent& phi) noexcept {
-    const T th = phi.norm();
+    const T th = detail::overflow_safe_norm(phi);
+    if (th > detail::large_angle<T>()) {
+      const Matrix U = hat(Tangent(phi / th));
+      const T s = std::sin(th / T(2));
+      return Matrix::Identity() - (T(2) * s * s / th) * U + (T(1) - std::sin(th) / th) * (U * U);
+    }
     const Matrix W = hat(phi);
     return Matrix::Identity() - detail::one_minus_cos_over_x2(th) * W +
            detail::x_minus_sin_over_x3(th) * (W * W);

@@ -96,6 +96,7 @@ template <class Buffers>
 
 /// Minimises the cost from the state w.x (left at the solution), on the
 /// layout L. Fills every field of the summary but the time and `planar`.
+/// @throws posefuse::invalid_argument as PoseGraphOptions::validate(), before any work
 ///
 /// `Assembly` gives cost(x), num_edges(), linearize(x) (into w.sys) and
 /// set_trigonometry(x) (the per-node quantities linearize() reads);
@@ -105,6 +106,7 @@ template <class Buffers>
 template <int B, class Assembly, class Buffers>
 [[nodiscard]] PoseGraphSummary levenberg_marquardt(Assembly& f, Buffers& w,
                                                    const PoseGraphLayout& L, const PoseGraphOptions& options) {
+  options.validate();
   PoseGraphSummary s;
   s.initial_cost = s.final_cost = f.cost(w.x);  // leaves the trigonometry at w.x
   if (L.n == 0 || f.num_edges() == 0) {

@@ -32,6 +32,17 @@ template <std::floating_point T>
   return std::sqrt(std::sqrt(std::numeric_limits<T>::epsilon()));
 }
 
+/// Angle (rad) above which SO(3) and SE(3) evaluate Exp and their Jacobians
+/// through the unit axis \f$ u = \phi / \theta \f$ and the angle's sine
+/// and cosine alone: \f$ 1/\sqrt{\epsilon} \f$ (6.7e7 rad in double). The
+/// closed forms in \f$ \phi \f$ multiply powers of θ up to \f$ \theta^5 \f$,
+/// which overflow for large finite angles (0 · ∞ = NaN); the axis forms are
+/// the same functions without them. Below this angle nothing changes.
+template <std::floating_point T>
+[[nodiscard]] inline T large_angle() noexcept {
+  return T(1) / std::sqrt(std::numeric_limits<T>::epsilon());
+}
+
 /// \f$ \sum_k c_k x^k \f$ by Horner's rule.
 template <std::floating_point T, std::size_t N>
 [[nodiscard]] constexpr T horner(T x, const T (&c)[N]) noexcept {
