@@ -61,8 +61,7 @@ TEST_CASE("EuRoC: malformed IMU files give file:line errors", "[io][euroc]") {
 TEST_CASE("EuRoC: IMU readings beyond the stated, configurable bounds are refused", "[io][euroc]") {
   posefuse::test::TempDir dir("euroc");
   const auto file = [&](const std::string& reading) {
-    return dir.write("imu.csv", std::string(kImuHeader) + "1000,0,0,0,0,0,9.81
-2000," + reading + "\n");
+    return dir.write("imu.csv", std::string(kImuHeader) + "1000,0,0,0,0,0,9.81\n2000," + reading + "\n");
   };
   // Defaults: 50 rad/s and 500 m/s^2 per axis (EuRoC's ADIS16448 saturates
   // at 17.5 rad/s and 176 m/s^2).
