@@ -43,9 +43,10 @@
 
 namespace posefuse {
 
-/// Largest focal length (px) a camera may have: its image would span less
-/// than a few arcseconds beyond it.
-inline constexpr double kMaxFocalPx = 1e7;
+/// Largest focal length (px) a camera may have: a 1000-pixel image then
+/// spans about 0.6 degrees, and beyond it the distortion's inversion cannot
+/// reach pixel accuracy.
+inline constexpr double kMaxFocalPx = 1e5;
 
 /// A pinhole camera with radial-tangential distortion (see the file comment).
 struct PinholeRadtan {
@@ -88,7 +89,7 @@ struct PinholeRadtan {
     if (!finite) throw invalid_argument("PinholeRadtan: a parameter is not finite");
     if (!(fu > 0 && fv > 0)) throw invalid_argument("PinholeRadtan: focal lengths must be > 0");
     // Below 1 px the image would span nearly 180 degrees (a pinhole cannot
-    // see 180); above kMaxFocalPx it would span less than a few arcseconds.
+    // see 180); above kMaxFocalPx see its comment.
     if (!(fu >= 1.0 && fv >= 1.0 && fu <= kMaxFocalPx && fv <= kMaxFocalPx))
       throw invalid_argument("PinholeRadtan: focal lengths (" + detail::message_number(fu) + ", " +
                              detail::message_number(fv) + " px) must be from 1 to " +
