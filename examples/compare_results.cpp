@@ -73,7 +73,7 @@ Row read_result(const std::filesystem::path& file, std::string name) {
         throw apps::data_error(file.string() + ": \"" + key + "\" is null; a saved result has finite statistics");
       const double v = j[key].number();
       if (!(v >= 0.0))
-        throw apps::data_error(file.string() + ": \"" + key + "\" is negative (" + apps::shortest(v) + ")");
+        throw apps::data_error(file.string() + ": \"" + key + "\" is negative (" + apps::num(v) + ")");
       return v;
     };
     Row r;
@@ -85,7 +85,7 @@ Row read_result(const std::filesystem::path& file, std::string name) {
     r.count = number("count");
     if (r.count < 1.0 || r.count != std::floor(r.count) || r.count > 9007199254740992.0)
       throw apps::data_error(file.string() + ": \"count\" must be a whole number of pairs >= 1, got " +
-                             apps::shortest(r.count));
+                             apps::num(r.count));
     r.rmse = number("rmse");
     r.mean = number("mean");
     r.median = number("median");
@@ -157,7 +157,7 @@ int main(int argc, char** argv) {
     bool json = false;
     apps::Parser cli(cmd.program, "--result FILE --result FILE ... [options]",
                      "Tabulates results saved by evaluate_trajectory --save-results (as evo_res).");
-    cli.paths({.name = "--result", .value = "FILE", .help = "a saved result (repeat for each)"}, files);
+    cli.inputs({.name = "--result", .value = "FILE", .help = "a saved result (repeat for each)"}, files);
     cli.text({.name = "--label", .value = "A,B,...", .help = "names of the results, in order"},
              label_list);
     cli.flag({.name = "--json", .help = "print one JSON array instead of the table"}, json);

@@ -75,14 +75,14 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   cli.integer({.name = "--seed", .value = "N", .help = "simulate the corridor with RNG seed N",
                .default_text = "1"},
               o.seed, std::uint64_t{0});
-  cli.path({.name = "--log", .value = "DIR",
+  cli.input({.name = "--log", .value = "DIR",
             .help = "run on a recorded log folder (wheels.csv, imu.csv, slam.csv,\n"
                     "robot.txt, optional groundtruth.csv)"},
            o.log);
-  cli.path({.name = "--write-log", .value = "DIR", .help = "save the simulated log to DIR (simulation only)"},
+  cli.output({.name = "--write-log", .value = "DIR", .help = "save the simulated log to DIR (simulation only)"},
            o.write_log);
   cli.flag({.name = "--json", .help = "print the figures as JSON instead of the table"}, o.json);
-  cli.path({.name = "--svg", .value = "FILE", .help = "write the four paths (and ground truth) as an SVG plot"},
+  cli.output({.name = "--svg", .value = "FILE", .help = "write the four paths (and ground truth) as an SVG plot"},
            o.svg);
   cli.epilogue("Exit status: 0 ok, 1 bad data (file:line of the log file at fault), 2 bad usage.");
   if (!cli.parse(cmd)) return std::nullopt;

@@ -104,8 +104,8 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   apps::Parser cli(cmd.program, "--groundtruth REF --estimate EST [options]",
                    "Absolute (APE) or relative (RPE) pose error of EST against REF, as evo_ape / "
                    "evo_rpe.");
-  cli.path({.name = "--groundtruth", .value = "FILE", .help = "reference trajectory (required)"}, ref);
-  cli.path({.name = "--estimate", .value = "FILE", .help = "estimated trajectory (required)"}, est);
+  cli.input({.name = "--groundtruth", .value = "FILE", .help = "reference trajectory (required)"}, ref);
+  cli.input({.name = "--estimate", .value = "FILE", .help = "estimated trajectory (required)"}, est);
   cli.custom({.name = "--format", .value = "auto|kitti|tum|euroc",
               .help = "format of both files (auto: told from the content, printed)",
               .default_text = "auto"},
@@ -116,7 +116,7 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   cli.custom({.name = "--estimate-format", .value = "F",
               .help = "format of EST only (overrides --format)"},
              format_flag(est_format));
-  cli.path({.name = "--times", .value = "FILE", .help = "KITTI times.txt, stamps every KITTI file given"},
+  cli.input({.name = "--times", .value = "FILE", .help = "KITTI times.txt, stamps every KITTI file given"},
            o.times);
   cli.custom({.name = "--duplicates", .value = "first|last|keep|error",
               .help = "equal consecutive stamps: keep the first or last pose (reported\n"
@@ -178,10 +178,10 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
               .help = "keep a pose only after DIST m or DEG degrees of motion\n"
                       "since the last kept one (each file)"},
              [&](std::string_view v) { o.motion_filter = parse_pair(v); });
-  cli.path({.name = "--save-results", .value = "FILE",
+  cli.output({.name = "--save-results", .value = "FILE",
             .help = "write statistics, per-pose errors and options as JSON"},
            o.save_results);
-  cli.path({.name = "--plot", .value = "FILE.svg",
+  cli.output({.name = "--plot", .value = "FILE.svg",
             .help = "draw both trajectories (EST aligned, coloured by error) and the\n"
                     "error over time with its statistics"},
            o.plot);
@@ -204,14 +204,6 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   o.estimate = *est;
   o.groundtruth_name = o.groundtruth.string();
   o.estimate_name = o.estimate.string();
-  {
-    std::vector<std::pair<std::string, std::filesystem::path>> outputs, inputs{{"--groundtruth", o.groundtruth},
-                                                                             {"--estimate", o.estimate}};
-    if (o.times) inputs.emplace_back("--times", *o.times);
-    if (o.save_results) outputs.emplace_back("--save-results", *o.save_results);
-    if (o.plot) outputs.emplace_back("--plot", *o.plot);
-    apps::refuse_output_over_input(outputs, inputs);
-  }
   o.ref_format_given = ref_format ? ref_format : format;
   o.est_format_given = est_format ? est_format : format;
   o.rpe.all_pairs = all_pairs;

@@ -50,6 +50,7 @@
 #include <Eigen/Cholesky>
 
 #include <apps/cli.hpp>
+#include <apps/imu_flags.hpp>
 #include <apps/json.hpp>
 #include <apps/output_file.hpp>
 #include <apps/progress.hpp>
@@ -65,6 +66,7 @@ namespace apps = posefuse::apps;
 struct Options {
   std::filesystem::path imu, groundtruth;
   std::optional<std::filesystem::path> svg;
+  posefuse::ImuReadOptions imu_bounds;
   double window_s = 1.0;
   double gravity = 9.81;
   posefuse::ImuNoise noise;  // EuRoC ADIS16448 defaults
@@ -108,8 +110,8 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   apps::Parser cli(cmd.program, "--imu FILE --groundtruth FILE [--window S] [options]",
                    "Pre-integrates a EuRoC IMU csv over windows of S seconds and compares it "
                    "with the ground-truth relative motion.");
-  cli.path({.name = "--imu", .value = "FILE", .help = "EuRoC imu0 csv (required)"}, imu);
-  cli.path({.name = "--groundtruth", .value = "FILE",
+  cli.input({.name = "--imu", .value = "FILE", .help = "EuRoC imu0 csv (required)"}, imu);
+  cli.input({.name = "--groundtruth", .value = "FILE",
             .help = "EuRoC state ground truth csv with velocity and biases (required)"},
            gt);
   cli.real({.name = "--window", .value = "S", .help = "window length", .unit = "s"}, o.window_s,
@@ -128,7 +130,8 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   cli.real({.name = "--accel-walk", .value = "X", .help = "accelerometer bias random walk",
             .unit = "m/s^3/sqrt(Hz)"},
            o.noise.accel_random_walk, apps::Domain::kNonNegative);
-  cli.path({.name = "--svg", .value = "FILE", .help = "plot the per-window errors"}, o.svg);
+  cli.output({.name = "--svg", .value = "FILE", .help = "plot the per-window errors"}, o.svg);
+  apps::declare_imu_bounds(cli, o.imu_bounds);
   cli.flag({.name = "--json", .help = "print one JSON object instead of the table"}, o.json);
   cli.epilogue("Exit status: 0 ok, 1 bad data (file:line where a file is at fault), 2 bad usage.");
   if (!cli.parse(cmd)) return std::nullopt;
@@ -178,7 +181,7 @@ Report run_check(const Options& o) {
   // On a terminal, standard error shows the files being read and the windows.
   apps::TerminalProgress progress("imu_preintegration_check");
   progress.stage("reading " + o.imu.string());
-  const std::vector<posefuse::ImuSample> imu = posefuse::read_euroc_imu(o.imu);
+  const std::vector<posefuse::ImuSample> imu = posefuse::read_euroc_imu(o.imu, o.imu_bounds);
   progress.stage("reading " + o.groundtruth.string());
   const posefuse::EurocGroundTruth gt = posefuse::read_euroc_groundtruth(o.groundtruth);
   progress.clear();

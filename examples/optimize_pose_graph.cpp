@@ -80,9 +80,9 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
                    "Optimises a planar g2o pose graph (VERTEX_SE2 / EDGE_SE2) or a 3-D one\n"
                    "(VERTEX_SE3:QUAT / EDGE_SE3:QUAT, detected from the file) and reports g2o's chi2.\n"
                    "Without --input it uses a built-in seeded planar graph.");
-  cli.path({.name = "--input", .value = "FILE.g2o", .help = "the graph"}, o.input);
-  cli.path({.name = "--out", .value = "FILE.g2o", .help = "write the optimised graph"}, o.out);
-  cli.path({.name = "--groundtruth", .value = "FILE",
+  cli.input({.name = "--input", .value = "FILE.g2o", .help = "the graph"}, o.input);
+  cli.output({.name = "--out", .value = "FILE.g2o", .help = "write the optimised graph"}, o.out);
+  cli.input({.name = "--groundtruth", .value = "FILE",
             .help = "true poses, one per vertex in file order: 'x y theta' or VERTEX_SE2\n"
                     "lines, or TORO 'EDGE2 i j dx dy dtheta ...' lines whose (i, i+1) edges\n"
                     "chained from the origin give the poses"},
@@ -122,13 +122,6 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   if (o.groundtruth && !o.input) throw apps::usage_error("--groundtruth needs --input");
   if (cli.given("--robust-scale") && o.loss.type == RobustLoss::kNone)
     throw apps::usage_error("--robust-scale needs a robust loss (--robust huber|cauchy)");
-  {
-    std::vector<std::pair<std::string, std::filesystem::path>> outputs, inputs;
-    if (o.input) inputs.emplace_back("--input", *o.input);
-    if (o.groundtruth) inputs.emplace_back("--groundtruth", *o.groundtruth);
-    if (o.out) outputs.emplace_back("--out", *o.out);
-    apps::refuse_output_over_input(outputs, inputs);
-  }
   return o;
 }
 
@@ -270,6 +263,58 @@ void check_nodes_are_fixed(const G2oGraph2d& g, const std::filesystem::path& fil
   }
 }
 
+/// check_nodes_are_fixed for a 3-D graph: a node tied to the fixed nodes
+/// only through edges of zero information, or only through edges of zero
+/// rotation information (its orientation would be free: the rotation block
+/// qx, qy, qz of every edge on each path is zero), or whose edges all have
+/// zero position (x, y, z) information, is refused at its VERTEX_SE3 line.
+void check_nodes_are_fixed_3d(const G2oGraph3d& g, const std::filesystem::path& file) {
+  const std::size_t n = g.vertices.size();
+  std::unordered_map<std::int64_t, std::size_t> index;
+  index.reserve(n);
+  for (std::size_t k = 0; k < n; ++k) index.emplace(g.vertices[k].id, k);
+  std::vector<std::size_t> informed(n), rotated(n), linked(n);
+  for (std::size_t k = 0; k < n; ++k) informed[k] = rotated[k] = linked[k] = k;
+  const auto find = [](std::vector<std::size_t>& parent, std::size_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  std::vector<double> position(n, 0.0);
+  for (const G2oEdgeSE3& e : g.edges) {
+    const auto ia = index.find(e.from), ib = index.find(e.to);
+    if (ia == index.end() || ib == index.end()) continue;  // reported by the graph's own checks
+    const std::size_t a = ia->second, b = ib->second;
+    const Eigen::Matrix<double, 6, 6>& I = e.information;
+    linked[find(linked, a)] = find(linked, b);
+    if (I.cwiseAbs().maxCoeff() > 0) informed[find(informed, a)] = find(informed, b);
+    if (I.bottomRightCorner<3, 3>().cwiseAbs().maxCoeff() > 0) rotated[find(rotated, a)] = find(rotated, b);
+    for (const std::size_t k : {a, b}) position[k] += I.topLeftCorner<3, 3>().trace();
+  }
+  std::vector<char> fixed(n, 0);
+  if (g.fixed.empty() && n > 0) fixed[0] = 1;
+  for (const std::int64_t id : g.fixed)
+    if (const auto it = index.find(id); it != index.end()) fixed[it->second] = 1;
+  std::vector<char> anchored(n, 0), oriented(n, 0), reached(n, 0);
+  for (std::size_t k = 0; k < n; ++k)
+    if (fixed[k]) {
+      anchored[find(informed, k)] = 1;
+      oriented[find(rotated, k)] = 1;
+      reached[find(linked, k)] = 1;
+    }
+  const auto refuse = [&](std::size_t k, const std::string& why) {
+    throw io_error(file, g.vertices[k].line,
+                   "node " + std::to_string(g.vertices[k].id) + " " + why +
+                       ", so the information does not determine its pose and the answer would depend on the start");
+  };
+  for (std::size_t k = 0; k < n; ++k) {
+    if (fixed[k] || !reached[find(linked, k)]) continue;
+    if (!anchored[find(informed, k)]) refuse(k, "is tied to the fixed node only through edges of zero information");
+    if (!oriented[find(rotated, k)])
+      refuse(k, "is tied to the fixed node only through edges of zero rotation information (qx, qy, qz block)");
+    if (position[k] == 0) refuse(k, "has no position information (every edge at it has a zero x, y, z block)");
+  }
+}
+
 /// The sentence for a graph whose information does not fix every node
 /// (the rotation-first systems are singular), from any start.
 [[noreturn]] void refuse_unfixed(const std::string& name) {
@@ -300,12 +345,20 @@ int run_3d(const Options& o) {
   } catch (const posefuse::invalid_argument& e) {
     throw apps::data_error(o.input->string() + ": " + e.what());
   }
+  progress.stage("checking the information");
+  check_nodes_are_fixed_3d(file_graph, *o.input);
   const double file_cost = graph.cost();
   const auto t0 = std::chrono::steady_clock::now();
-  if (o.rotation_first) {
-    progress.stage("chordal initialisation");
+  // The chordal systems are solvable exactly when the information fixes
+  // every rotation and position; from the file's poses the same check runs
+  // on a copy, so that both starts refuse the same graphs.
+  {
+    progress.stage(o.rotation_first ? "chordal initialisation" : "checking the information");
+    PoseGraphSE3 copy;
+    PoseGraphSE3& target = o.rotation_first ? graph : copy;
+    if (!o.rotation_first) copy = graph;
     try {
-      graph.initialize_chordal();
+      target.initialize_chordal();
     } catch (const posefuse::invalid_argument& e) {
       if (std::string_view(e.what()).find("singular") == std::string_view::npos)
         throw apps::data_error(name + ": " + e.what());

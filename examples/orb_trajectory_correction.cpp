@@ -60,6 +60,7 @@
 #include <apps/cli.hpp>
 #include <apps/json.hpp>
 #include <apps/output_file.hpp>
+#include <apps/progress.hpp>
 #include <apps/seed000_methods.hpp>
 #include <apps/seed000_sweep.hpp>
 #include <apps/svg.hpp>
@@ -93,13 +94,25 @@ struct Options {
   bool folders = false;  ///< --groundtruth / --estimate are folders of same-named files
 };
 
-/// "VAR" or "VAR,VAR": a diagonal covariance, each variance finite and > 0.
+/// Noise values (variances, acceleration noise) the filters can use: beyond
+/// these every filter step fails (a covariance overflows or vanishes), so a
+/// value outside is a usage error naming its flag.
+constexpr double kMinNoise = 1e-8, kMaxNoise = 1e8;
+
+/// One noise value in [kMinNoise, kMaxNoise].
+double parse_noise(std::string_view text) {
+  const double v = apps::parse_real(text, apps::Domain::kPositive);
+  if (!(v >= kMinNoise && v <= kMaxNoise))
+    throw apps::usage_error("expected a number from " + apps::num(kMinNoise) + " to " + apps::num(kMaxNoise) +
+                            ", got '" + std::string(text) + "'");
+  return v;
+}
+
+/// "VAR" or "VAR,VAR": a diagonal covariance, each variance in [kMinNoise, kMaxNoise].
 Eigen::Matrix2d parse_diag(std::string_view text) {
   const auto comma = text.find(',');
-  const double a = apps::parse_real(text.substr(0, comma), apps::Domain::kPositive);
-  const double b = comma == std::string_view::npos
-                       ? a
-                       : apps::parse_real(text.substr(comma + 1), apps::Domain::kPositive);
+  const double a = parse_noise(text.substr(0, comma));
+  const double b = comma == std::string_view::npos ? a : parse_noise(text.substr(comma + 1));
   return Eigen::Vector2d(a, b).asDiagonal();
 }
 
@@ -114,14 +127,14 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
                    "Filters SLAM trajectories on the road plane (seed 000) and compares the planar "
                    "RMSE\nagainst ground truth before and after. Without files it uses a built-in "
                    "synthetic drive.");
-  cli.path({.name = "--groundtruth", .value = "FILE|DIR",
+  cli.input({.name = "--groundtruth", .value = "FILE|DIR",
             .help = "reference trajectory; a folder: one same-named file per sequence\n"
                     "of the --estimate folder (00.txt, 05.txt, ...)"},
            o.groundtruth);
-  cli.paths({.name = "--estimate", .value = "FILE|DIR",
+  cli.inputs({.name = "--estimate", .value = "FILE|DIR",
              .help = "trajectory to correct (repeat for several), or one folder"},
             o.estimates);
-  cli.path({.name = "--control", .value = "FILE|DIR",
+  cli.input({.name = "--control", .value = "FILE|DIR",
             .help = "independent trajectory whose planar displacement is the control u\n"
                     "of method 'control' (associated with the estimate by timestamp)"},
            o.control);
@@ -138,24 +151,24 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
                if (o.format == Format::kEuroc)
                  throw apps::usage_error("expected kitti or tum (EuRoC files: evaluate_trajectory)");
              });
-  cli.path({.name = "--times", .value = "FILE|DIR",
+  cli.input({.name = "--times", .value = "FILE|DIR",
             .help = "KITTI times.txt for all KITTI files (a folder: one per sequence)"},
            o.times);
   cli.custom({.name = "--plane", .value = "xz|xy|yz", .help = "road plane",
               .default_text = "xz: KITTI camera frame"},
              [&](std::string_view v) { o.plane = parse_plane(v); });
-  cli.custom({.name = "--R", .value = "VAR[,VAR]", .help = "seed's process noise R = diag",
+  cli.custom({.name = "--R", .value = "VAR[,VAR]", .help = "seed's process noise R = diag; 1e-08 to 1e+08",
               .default_text = "0.01 m^2/frame"},
              [&](std::string_view v) { o.R = parse_diag(v); });
-  cli.custom({.name = "--Q", .value = "VAR[,VAR]", .help = "seed's measurement noise Q = diag",
+  cli.custom({.name = "--Q", .value = "VAR[,VAR]", .help = "seed's measurement noise Q = diag; 1e-08 to 1e+08",
               .default_text = "0.25 m^2"},
              [&](std::string_view v) { o.Q = parse_diag(v); });
-  cli.real({.name = "--cv-q", .value = "Q", .help = "constant-velocity acceleration noise",
-            .unit = "m^2/s^3"},
-           o.cv_q, apps::Domain::kPositive);
-  cli.real({.name = "--ctrv-q", .value = "Q",
-            .help = "CTRV acceleration noise (yaw acceleration: Q / (10 m/s)^2)", .unit = "m^2/s^3"},
-           o.ctrv_q, apps::Domain::kPositive);
+  cli.real_in({.name = "--cv-q", .value = "Q", .help = "constant-velocity acceleration noise",
+               .unit = "m^2/s^3"},
+              o.cv_q, kMinNoise, kMaxNoise);
+  cli.real_in({.name = "--ctrv-q", .value = "Q",
+               .help = "CTRV acceleration noise (yaw acceleration: Q / (10 m/s)^2)", .unit = "m^2/s^3"},
+              o.ctrv_q, kMinNoise, kMaxNoise);
   cli.custom({.name = "--align", .value = "none|se3|sim3",
               .help = "align each estimate to the ground truth first (sim3: monocular);\n"
                       "a control is aligned to its estimate the same way",
@@ -172,7 +185,7 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
             .help = "print the RMSE over a decade grid of process x measurement noise\n"
                     "for each method (one estimate)"},
            o.sweep);
-  cli.path({.name = "--sweep-svg", .value = "FILE.svg", .help = "the --sweep grid as heat maps"},
+  cli.output({.name = "--sweep-svg", .value = "FILE.svg", .help = "the --sweep grid as heat maps"},
            o.sweep_svg);
   cli.custom({.name = "--method", .value = "NAME",
               .help = "corrector whose output --out writes: seed000, cv, cv+rts, ctrv,\n"
@@ -189,11 +202,11 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
                                          name + "'");
                o.method = name;
              });
-  cli.path({.name = "--out", .value = "PATH",
+  cli.output({.name = "--out", .value = "PATH",
             .help = "write the corrected trajectory (input format); with several\n"
                     "estimates PATH is a folder of <estimate>_<method> files"},
            o.out);
-  cli.path({.name = "--plot", .value = "FILE.svg",
+  cli.output({.name = "--plot", .value = "FILE.svg",
             .help = "paths of the first estimate (truth, raw, corrected) and covariance\n"
                     "over time (seed 000 Fig. 8)"},
            o.plot);
@@ -214,6 +227,9 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   if (o.method.starts_with("control") && !o.control)
     throw apps::usage_error("--method " + o.method + " needs --control");
   if (o.sweep_svg && !o.sweep) throw apps::usage_error("--sweep-svg draws the --sweep grid; give --sweep");
+  if (tune_only && o.alignment != Alignment::kNone && !o.control)
+    throw apps::usage_error("--align aligns to the ground truth (or a --control to its estimate); without "
+                            "--groundtruth and --control it does nothing");
   if (tune_only && (o.out || o.plot || o.sweep))
     throw apps::usage_error("without --groundtruth, --tune only chooses noise: --out, --plot and "
                             "--sweep need --groundtruth");
@@ -234,17 +250,6 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
     if (o.control && is_dir(*o.control))
       throw apps::usage_error("--control is a folder but --estimate is not");
     if (o.sweep && o.estimates.size() > 1) throw apps::usage_error("--sweep studies one estimate; give one --estimate");
-  }
-  {
-    std::vector<std::pair<std::string, fs::path>> outputs, inputs;
-    if (o.groundtruth) inputs.emplace_back("--groundtruth", *o.groundtruth);
-    if (o.times) inputs.emplace_back("--times", *o.times);
-    if (o.control) inputs.emplace_back("--control", *o.control);
-    for (const auto& e : o.estimates) inputs.emplace_back("--estimate", e);
-    if (o.out && o.estimates.size() <= 1 && !o.folders) outputs.emplace_back("--out", *o.out);
-    if (o.plot) outputs.emplace_back("--plot", *o.plot);
-    if (o.sweep_svg) outputs.emplace_back("--sweep-svg", *o.sweep_svg);
-    apps::refuse_output_over_input(outputs, inputs);
   }
   if (o.out && o.estimates.size() > 1) {
     std::set<std::string> names;
@@ -280,7 +285,7 @@ struct EstimateResult {
 
 /// Throws a data error when `v` is not finite: no inf or nan reaches the output.
 void require_finite(double v, const std::string& what) {
-  if (!std::isfinite(v)) throw apps::data_error(what + " is not finite (" + apps::shortest(v) + ")");
+  if (!std::isfinite(v)) throw apps::data_error(what + " is not finite (" + apps::num(v) + ")");
 }
 
 void require_finite(const std::vector<Eigen::Vector2d>& points, const std::string& what) {
@@ -308,6 +313,13 @@ Trajectory with_plane_points(const Trajectory& base, const std::vector<Eigen::Ve
   return out;
 }
 
+/// "<first> to <last> s" of a trajectory's stamps (exact), or "no poses".
+std::string span_of(const Trajectory& t) {
+  if (t.size() == 0) return "no poses";
+  return posefuse::detail::traj_io::format_number(t.t_s.front()) + " to " +
+         posefuse::detail::traj_io::format_number(t.t_s.back()) + " s";
+}
+
 /// The frames of `est` that also have a control pose (by timestamp), with
 /// `gt` (same frames as `est`, may be empty) reduced alike.
 /// @throws data_error naming the control file when fewer than 2 frames match
@@ -317,8 +329,8 @@ Trajectory associate_control(const std::string& est_source, Trajectory& est, Tra
   Association a;
   try {
     a = associate(std::span<const double>(est.t_s), std::span<const double>(control.t_s), max_time_diff);
-  } catch (const posefuse::invalid_argument& e) {
-    throw apps::data_error(control_source + ": " + e.what() + " (against " + est_source + ")");
+  } catch (const posefuse::invalid_argument&) {
+    a = {};  // no pair: reported below with the time spans
   }
   // Keep pairs where both indices advance (the nearest-stamp rule can repeat one).
   std::vector<std::size_t> ei, ci;
@@ -328,10 +340,24 @@ Trajectory associate_control(const std::string& est_source, Trajectory& est, Tra
   if (ei.size() < 2)
     throw apps::data_error(control_source + ": only " + std::to_string(ei.size()) +
                            " frame(s) associate with " + est_source + " within --max-time-diff " +
-                           apps::shortest(max_time_diff) + " s; the control needs at least 2");
+                           apps::num(max_time_diff) + " s (the control spans " + span_of(control) +
+                           ", the estimate " + span_of(est) + "); the control needs at least 2");
   est = select(est, ei);
   if (gt != nullptr) *gt = select(*gt, ei);
   return select(control, ci);
+}
+
+/// `traj` aligned to `ref` as --align asks; a pair that cannot be aligned
+/// (too few poses, all on one point or line) is a data error naming `source`.
+AlignedTrajectory aligned_to(const Trajectory& traj, const Trajectory& ref, Alignment alignment,
+                             const std::string& source, const std::string& ref_source) {
+  try {
+    return align_trajectory(traj, ref, alignment);
+  } catch (const posefuse::invalid_argument&) {
+    throw apps::data_error(source + ": --align " + std::string(to_string(alignment)) + " cannot align its " +
+                           std::to_string(traj.size()) + " poses to " + ref_source +
+                           " (it needs at least 3 that do not all lie on one point or line); try --align none");
+  }
 }
 
 /// @param by_stamps associate the estimate with the ground truth by
@@ -346,7 +372,14 @@ EstimateResult correct(std::string name, std::string source, const Trajectory* g
   if (!r.has_truth) {
     r.estimate = est_full;
   } else if (by_stamps) {
-    const AssociatedTrajectories a = associate(*gt_full, est_full, o.max_time_diff);
+    AssociatedTrajectories a;
+    try {
+      a = associate(*gt_full, est_full, o.max_time_diff);
+    } catch (const posefuse::invalid_argument&) {
+      throw apps::data_error(r.source + ": no pose within --max-time-diff " + apps::num(o.max_time_diff) +
+                             " s of a ground-truth pose (the ground truth spans " + span_of(*gt_full) +
+                             ", the estimate " + span_of(est_full) + ")");
+    }
     r.groundtruth = a.ref;
     r.estimate = a.est;
   } else {
@@ -367,15 +400,15 @@ EstimateResult correct(std::string name, std::string source, const Trajectory* g
   const Trajectory own = r.estimate;
   Trajectory own_control = control;
   if (control_full != nullptr && o.alignment != Alignment::kNone)
-    own_control = align_trajectory(control, own, o.alignment).trajectory;
+    own_control = aligned_to(control, own, o.alignment, control_source, r.source).trajectory;
   AlignmentResult to_truth;
   if (r.has_truth) {
-    AlignedTrajectory aligned = align_trajectory(r.estimate, r.groundtruth, o.alignment);
+    AlignedTrajectory aligned = aligned_to(r.estimate, r.groundtruth, o.alignment, r.source, "the ground truth");
     r.estimate = std::move(aligned.trajectory);
     to_truth = aligned.transform;
   }
   if (control_full != nullptr && o.alignment != Alignment::kNone)
-    control = align_trajectory(control, r.estimate, o.alignment).trajectory;
+    control = aligned_to(control, r.estimate, o.alignment, control_source, r.source).trajectory;
   r.raw_xy = project_to_plane(r.estimate, o.plane);
   require_finite(r.raw_xy, r.source + ": the estimate on the road plane" +
                                std::string(o.alignment == Alignment::kNone ? "" : " after alignment"));
@@ -703,7 +736,9 @@ std::vector<SequenceFiles> sequences(const Options& o) {
   return out;
 }
 
-int run(const Options& o) {
+int run(const Options& o, const std::string& program) {
+  // On a terminal, standard error shows the sequence being corrected.
+  apps::TerminalProgress progress(program);
   // 1. Compute everything; any failure stops here, before an output exists.
   std::vector<EstimateResult> results;
   if (o.estimates.empty()) {
@@ -712,7 +747,10 @@ int run(const Options& o) {
                               drive.estimate, nullptr, {}, o.format == Format::kTum, o));
     results.back().format = o.format;
   } else {
-    for (const SequenceFiles& s : sequences(o)) {
+    const std::vector<SequenceFiles> seqs = sequences(o);
+    for (const SequenceFiles& s : seqs) {
+      progress.stage("correcting " + s.estimate.string() + " (" + std::to_string(results.size() + 1) + "/" +
+                     std::to_string(seqs.size()) + ")");
       const auto format_of = [&](const fs::path& p) {
         if (!o.auto_format) return o.format;
         const Format f = detect_format(p);
@@ -747,8 +785,10 @@ int run(const Options& o) {
         {Family::kCtrv, {o.ctrv_q, 0.5 * o.Q.trace()}}};
     if (!r.input.control.empty())
       families.push_back({Family::kControl, {0.5 * o.R.trace(), 0.5 * o.Q.trace()}});
+    progress.stage("sweeping the noise grid of " + r.source);
     sweep = apps::seed000::sweep(r.input, r.truth_xy, families);
   }
+  progress.clear();
 
   // 2. The output files, in memory (the SVG refuses non-finite numbers).
   apps::OutputFiles files;
@@ -794,6 +834,6 @@ int run(const Options& o) {
 int main(int argc, char** argv) {
   return posefuse::apps::run_main(argc, argv, [](const posefuse::apps::CommandLine& cmd) {
     const std::optional<Options> o = parse_options(cmd);
-    return o ? run(*o) : 0;
+    return o ? run(*o, cmd.program) : 0;
   });
 }

@@ -83,10 +83,10 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   apps::Parser cli(cmd.program, "[--odometry FILE --groundtruth FILE (--loops FILE | --oracle-loops)] [options]",
                    "Corrects drifting odometry with loop closures on a 4-DoF pose graph and prints the\n"
                    "APE before and after. Without files it uses a built-in simulated drive.");
-  cli.path({.name = "--odometry", .value = "FILE", .help = "the drifting trajectory"}, o.odometry);
-  cli.path({.name = "--groundtruth", .value = "FILE", .help = "reference, one pose per odometry pose"},
+  cli.input({.name = "--odometry", .value = "FILE", .help = "the drifting trajectory"}, o.odometry);
+  cli.input({.name = "--groundtruth", .value = "FILE", .help = "reference, one pose per odometry pose"},
            o.groundtruth);
-  cli.path({.name = "--loops", .value = "FILE", .help = "4-DoF loop edges (i j x y z yaw + 10 information values)"},
+  cli.input({.name = "--loops", .value = "FILE", .help = "4-DoF loop edges (i j x y z yaw + 10 information values)"},
            o.loops);
   cli.flag({.name = "--oracle-loops",
             .help = "propose loop edges from ground-truth revisits (an ORACLE for evaluating\n"
@@ -114,8 +114,8 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
              });
   cli.real({.name = "--robust-scale", .value = "S", .help = "robust-loss scale (whitened units)"}, o.loss.scale,
            apps::Domain::kPositive);
-  cli.path({.name = "--out", .value = "FILE", .help = "write the corrected trajectory (input format)"}, o.out);
-  cli.path({.name = "--svg", .value = "FILE.svg", .help = "top view: truth, before, after, loop edges"}, o.svg);
+  cli.output({.name = "--out", .value = "FILE", .help = "write the corrected trajectory (input format)"}, o.out);
+  cli.output({.name = "--svg", .value = "FILE.svg", .help = "top view: truth, before, after, loop edges"}, o.svg);
   cli.custom({.name = "--dof", .value = "4|6",
               .help = "4: x, y, z, yaw (roll and pitch held, visual-inertial odometry);\n"
                       "6: SE(3), every direction free (visual-only odometry)",
@@ -140,15 +140,6 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
     throw apps::usage_error("--loops holds 4-DoF edges (no roll or pitch); with --dof 6 use --oracle-loops");
   if (cli.given("--robust-scale") && o.loss.type == RobustLoss::kNone)
     throw apps::usage_error("--robust-scale needs a robust loss (--robust huber|cauchy)");
-  {
-    std::vector<std::pair<std::string, std::filesystem::path>> outputs, inputs;
-    if (o.odometry) inputs.emplace_back("--odometry", *o.odometry);
-    if (o.groundtruth) inputs.emplace_back("--groundtruth", *o.groundtruth);
-    if (o.loops) inputs.emplace_back("--loops", *o.loops);
-    if (o.out) outputs.emplace_back("--out", *o.out);
-    if (o.svg) outputs.emplace_back("--svg", *o.svg);
-    apps::refuse_output_over_input(outputs, inputs);
-  }
   return o;
 }
 

@@ -17,6 +17,7 @@
 // wrong associations, tracks and their mean length, landmarks. Exit status:
 // 0 ok, 1 bad data (file:line where a file is at fault), 2 bad usage.
 
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -28,6 +29,7 @@
 #include <apps/cli.hpp>
 #include <apps/json.hpp>
 #include <apps/output_file.hpp>
+#include <apps/progress.hpp>
 #include <posefuse/io/detail/text.hpp>
 #include <posefuse/io/euroc.hpp>
 #include <posefuse/io/feature_tracks.hpp>
@@ -56,45 +58,44 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
                    "(or the built-in synthetic flight) through a room of point landmarks, and "
                    "writes them as t_ns,feature_id,u,v csv. The vision is synthetic; with a real "
                    "ground truth and its IMU the sequence is semi-real.");
-  cli.path({.name = "--out", .value = "FILE", .help = "feature-track csv to write (required)"}, o.out);
-  cli.path({.name = "--groundtruth", .value = "FILE",
+  cli.output({.name = "--out", .value = "FILE", .help = "feature-track csv to write (required)"}, o.out);
+  cli.input({.name = "--groundtruth", .value = "FILE",
             .help = "EuRoC ground truth csv (8 or 17 columns): the motion\n(default: the synthetic flight)"},
            o.groundtruth);
-  cli.path({.name = "--camera", .value = "FILE",
+  cli.input({.name = "--camera", .value = "FILE",
             .help = "EuRoC camera sensor.yaml (required with --groundtruth;\ndefault: EuRoC cam0 intrinsics looking along body x)"},
            o.camera);
-  cli.real({.name = "--rate", .value = "HZ", .help = "frame rate", .unit = "Hz"}, c.rate_hz,
-           apps::Domain::kPositive);
-  cli.real({.name = "--noise-px", .value = "S", .help = "pixel noise sigma per axis", .unit = "px"},
-           c.pixel_noise_px, apps::Domain::kNonNegative);
-  cli.real({.name = "--outliers", .value = "F", .help = "fraction of wrong associations, in [0, 1)"},
-           c.outlier_fraction, apps::Domain::kNonNegative);
+  cli.real_in({.name = "--rate", .value = "HZ", .help = "frame rate", .unit = "Hz"}, c.rate_hz, 0.1, 1000.0);
+  cli.real_in({.name = "--noise-px", .value = "S", .help = "pixel noise sigma per axis", .unit = "px"},
+              c.pixel_noise_px, 0.0, 20.0);
+  cli.real_in({.name = "--outliers", .value = "F", .help = "fraction of wrong associations"},
+              c.outlier_fraction, 0.0, 0.9);
   cli.integer({.name = "--features", .value = "N", .help = "tracked features wanted per frame"},
               c.features_per_frame, 1, 100000);
   cli.integer({.name = "--max-track-length", .value = "N", .help = "longest track (frames)"},
               c.max_track_length, 2, 1000000);
-  cli.real({.name = "--min-distance", .value = "PX", .help = "new features this far from tracked ones",
-            .unit = "px"},
-           c.min_feature_distance_px, apps::Domain::kNonNegative);
-  cli.real({.name = "--room-margin", .value = "M", .help = "walls beyond the path's bounding box", .unit = "m"},
-           c.room_margin_m, apps::Domain::kPositive);
-  cli.real({.name = "--wall-density", .value = "D", .help = "wall landmarks per square metre"},
-           c.wall_density_per_m2, apps::Domain::kNonNegative);
+  cli.real_in({.name = "--min-distance", .value = "PX", .help = "new features this far from tracked ones",
+               .unit = "px"},
+              c.min_feature_distance_px, 0.0, 1000.0);
+  cli.real_in({.name = "--room-margin", .value = "M", .help = "walls beyond the path's bounding box", .unit = "m"},
+              c.room_margin_m, 0.1, 1000.0);
+  cli.real_in({.name = "--wall-density", .value = "D", .help = "wall landmarks per square metre"},
+              c.wall_density_per_m2, 0.0, 1000.0);
   cli.integer({.name = "--free-points", .value = "N", .help = "free landmarks inside the room"}, c.free_points,
               0, 10000000);
-  cli.real({.name = "--max-pose-gap", .value = "S", .help = "longest ground-truth interval a frame may be\ninterpolated across",
-            .unit = "s"},
-           c.max_pose_gap_s, apps::Domain::kPositive);
+  cli.real_in({.name = "--max-pose-gap", .value = "S",
+               .help = "longest ground-truth interval a frame may be\ninterpolated across", .unit = "s"},
+              c.max_pose_gap_s, 0.001, 3600.0);
   cli.integer({.name = "--seed", .value = "N", .help = "random seed"}, c.seed);
   cli.flag({.name = "--recurring-ids",
             .help = "a landmark keeps its id when seen again (an oracle for\nloop closure: perfect re-identification)"},
            c.recurring_ids);
-  cli.real({.name = "--duration", .value = "S", .help = "synthetic flight length", .unit = "s"}, o.duration_s,
-           apps::Domain::kPositive);
-  cli.path({.name = "--groundtruth-out", .value = "FILE",
+  cli.real_in({.name = "--duration", .value = "S", .help = "synthetic flight length", .unit = "s"}, o.duration_s,
+              0.1, 3600.0);
+  cli.output({.name = "--groundtruth-out", .value = "FILE",
             .help = "synthetic flight only: write its ground truth (EuRoC csv,\n17 columns, 200 Hz)"},
            o.groundtruth_out);
-  cli.path({.name = "--imu-out", .value = "FILE",
+  cli.output({.name = "--imu-out", .value = "FILE",
             .help = "synthetic flight only: write a simulated IMU (EuRoC imu0 csv,\n200 Hz, EuRoC ADIS16448 noise, seeded with --seed)"},
            o.imu_out);
   cli.flag({.name = "--json", .help = "print one JSON object instead of the summary"}, o.json);
@@ -104,12 +105,41 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   if (o.groundtruth && !o.camera) throw apps::usage_error("--groundtruth needs --camera");
   if (o.groundtruth && (o.groundtruth_out || o.imu_out || cli.given("--duration")))
     throw apps::usage_error("--duration, --groundtruth-out and --imu-out are for the synthetic flight only");
-  try {
-    c.validate();
-  } catch (const posefuse::invalid_argument& e) {
-    throw apps::usage_error(e.what());
-  }
+  if (c.wall_density_per_m2 == 0 && c.free_points == 0)
+    throw apps::usage_error("--wall-density 0 and --free-points 0 leave the room without landmarks");
+  c.validate();  // every field is bounded by its flag above; a failure here is a bug
   return o;
+}
+
+// Refuses (usage_error, before anything is allocated) a simulation larger
+// than sim::kMaxSimulatedLandmarks landmarks or sim::kMaxSimulatedObservations
+// observations, naming the flags that make it so.
+void check_size(const Options& o, double frames, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                const std::string& span) {
+  const sim::TrackSimSize size = sim::track_simulation_size(frames, lo, hi, o.config);
+  if (size.landmarks > sim::kMaxSimulatedLandmarks)
+    throw apps::usage_error("--wall-density " + apps::num(o.config.wall_density_per_m2) + " on the walls of a room " +
+                            apps::num(o.config.room_margin_m) + " m (--room-margin) beyond the path gives about " +
+                            apps::num(size.landmarks) + " landmarks, more than the " +
+                            apps::num(sim::kMaxSimulatedLandmarks) + " one run may hold");
+  if (size.max_observations > sim::kMaxSimulatedObservations)
+    throw apps::usage_error("--rate " + apps::num(o.config.rate_hz) + " Hz over " + span + " gives " +
+                            apps::num(frames) + " frames of up to " + std::to_string(o.config.features_per_frame) +
+                            " features (--features): up to " + apps::num(size.max_observations) +
+                            " observations, more than the " + apps::num(sim::kMaxSimulatedObservations) +
+                            " one run may hold");
+}
+
+// The bounding box of a trajectory's positions, grown by the camera's lever arm.
+void path_box(const std::vector<Eigen::Isometry3d>& poses, const posefuse::PinholeRadtan& camera,
+              Eigen::Vector3d& lo, Eigen::Vector3d& hi) {
+  lo = hi = poses.front().translation();
+  for (const Eigen::Isometry3d& T : poses) {
+    lo = lo.cwiseMin(T.translation());
+    hi = hi.cwiseMax(T.translation());
+  }
+  lo.array() -= camera.T_BS.translation().norm();
+  hi.array() += camera.T_BS.translation().norm();
 }
 
 std::string num(double v) { return posefuse::detail::traj_io::format_number(v); }
@@ -142,20 +172,32 @@ std::string imu_csv(const std::vector<posefuse::ImuSample>& imu) {
   return s;
 }
 
-int run(const Options& o) {
+int run(const Options& o, const std::string& program) {
+  apps::TerminalProgress progress(program);
   const posefuse::PinholeRadtan camera =
       o.camera ? posefuse::read_euroc_camera(*o.camera) : sim::synthetic_camera();
   sim::SimulatedTracks s;
   apps::OutputFiles files;
+  Eigen::Vector3d lo, hi;
   if (o.groundtruth) {
+    progress.stage("reading " + o.groundtruth->string());
     const posefuse::EurocGroundTruth gt = posefuse::read_euroc_groundtruth(*o.groundtruth);
+    const double span_s = double(gt.t_ns.back() - gt.t_ns.front()) * 1e-9;
+    path_box(gt.trajectory.poses, camera, lo, hi);
+    check_size(o, std::floor(span_s * o.config.rate_hz) + 1, lo, hi,
+               "the " + apps::num(span_s) + " s of --groundtruth");
+    progress.stage("simulating " + apps::num(std::floor(span_s * o.config.rate_hz) + 1) + " frames");
     try {
       s = sim::simulate_feature_tracks(gt, camera, o.config);
-    } catch (const posefuse::invalid_argument& e) {
-      throw posefuse::io_error(*o.groundtruth, e.what());
+    } catch (const posefuse::invalid_argument& e) {  // a gap longer than --max-pose-gap
+      throw posefuse::io_error(*o.groundtruth, std::string(e.what()) + " (--max-pose-gap)");
     }
   } else {
     posefuse::sim::ImuSimConfig flight = sim::synthetic_flight();
+    path_box(sim::synthetic_groundtruth(flight, o.duration_s, 10.0).trajectory.poses, camera, lo, hi);
+    check_size(o, std::floor(o.duration_s * o.config.rate_hz) + 1, lo, hi,
+               "--duration " + apps::num(o.duration_s) + " s");
+    progress.stage("simulating " + apps::num(std::floor(o.duration_s * o.config.rate_hz) + 1) + " frames");
     s = sim::simulate_feature_tracks(flight, o.duration_s, camera, o.config);
     if (o.groundtruth_out)
       files.add(*o.groundtruth_out, groundtruth_csv(sim::synthetic_groundtruth(flight, o.duration_s, 200.0)));
@@ -165,8 +207,14 @@ int run(const Options& o) {
       files.add(*o.imu_out, imu_csv(sim::simulate_imu(flight, o.duration_s).samples));
     }
   }
+  if (s.observations == 0)
+    throw apps::data_error("the camera saw no landmark in any of the " + std::to_string(s.tracks.size()) +
+                           " frames (is the camera's image in the room? see --camera, --noise-px, --room-margin, "
+                           "--wall-density, --free-points); nothing was written");
   files.add_with(*o.out, [&s](const std::filesystem::path& p) { posefuse::write_feature_tracks(p, s.tracks); });
+  progress.stage("writing " + o.out->string());
   files.commit();
+  progress.clear();
 
   const double frames = double(s.tracks.size());
   const double per_frame = frames > 0 ? double(s.observations) / frames : 0.0;
@@ -200,6 +248,6 @@ int run(const Options& o) {
 int main(int argc, char** argv) {
   return apps::run_main(argc, argv, [](const apps::CommandLine& cmd) {
     const std::optional<Options> o = parse_options(cmd);
-    return o ? run(*o) : 0;
+    return o ? run(*o, cmd.program) : 0;
   });
 }

@@ -55,6 +55,7 @@
 #include <vector>
 
 #include <apps/cli.hpp>
+#include <apps/imu_flags.hpp>
 #include <apps/json.hpp>
 #include <apps/output_file.hpp>
 #include <apps/progress.hpp>
@@ -70,6 +71,7 @@ constexpr int kFrames = 10;
 struct Options {
   std::filesystem::path imu, groundtruth;
   std::optional<std::filesystem::path> svg;
+  posefuse::ImuReadOptions imu_bounds;
   double keyframe_interval_s = 0.25;
   int stride = 5;
   double sfm_scale = 0.37;
@@ -111,8 +113,8 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   apps::Parser cli(cmd.program, "--imu FILE --groundtruth FILE [options]",
                    "Runs visual-inertial alignment over sliding windows of 10 keyframes with "
                    "up-to-scale poses made from the ground truth, and scores it.");
-  cli.path({.name = "--imu", .value = "FILE", .help = "EuRoC imu0 csv (required)"}, imu);
-  cli.path({.name = "--groundtruth", .value = "FILE",
+  cli.input({.name = "--imu", .value = "FILE", .help = "EuRoC imu0 csv (required)"}, imu);
+  cli.input({.name = "--groundtruth", .value = "FILE",
             .help = "EuRoC state ground truth csv with velocity and biases (required)"},
            gt);
   cli.real({.name = "--keyframe-interval", .value = "S", .help = "time between keyframes",
@@ -133,7 +135,8 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
             .help = "pre-integrate about the ground-truth accelerometer bias (the alignment does "
                     "not estimate it)"},
            o.gt_accel_bias);
-  cli.path({.name = "--svg", .value = "FILE", .help = "plot the per-window errors"}, o.svg);
+  cli.output({.name = "--svg", .value = "FILE", .help = "plot the per-window errors"}, o.svg);
+  apps::declare_imu_bounds(cli, o.imu_bounds);
   cli.flag({.name = "--json", .help = "print one JSON object instead of the table"}, o.json);
   cli.epilogue("Exit status: 0 ok, 1 bad data (file:line where a file is at fault), 2 bad usage.");
   if (!cli.parse(cmd)) return std::nullopt;
@@ -177,7 +180,7 @@ Report run_check(const Options& o) {
   // On a terminal, standard error shows the files being read and the windows.
   apps::TerminalProgress progress("vi_alignment_check");
   progress.stage("reading " + o.imu.string());
-  const std::vector<posefuse::ImuSample> imu = posefuse::read_euroc_imu(o.imu);
+  const std::vector<posefuse::ImuSample> imu = posefuse::read_euroc_imu(o.imu, o.imu_bounds);
   progress.stage("reading " + o.groundtruth.string());
   const posefuse::EurocGroundTruth gt = posefuse::read_euroc_groundtruth(o.groundtruth);
   progress.clear();

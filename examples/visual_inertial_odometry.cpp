@@ -50,11 +50,14 @@
 #include <vector>
 
 #include <apps/cli.hpp>
+#include <apps/imu_flags.hpp>
 #include <apps/json.hpp>
 #include <apps/output_file.hpp>
+#include <apps/progress.hpp>
 #include <posefuse/eval/metrics.hpp>
 #include <posefuse/io/association.hpp>
 #include <posefuse/io/euroc.hpp>
+#include <posefuse/io/feature_tracks.hpp>
 #include <posefuse/io/imu_gaps.hpp>
 #include <posefuse/io/loop_candidates.hpp>
 #include <posefuse/io/tum.hpp>
@@ -82,6 +85,8 @@ struct Options {
   double outlier_px = 5.26;
   std::size_t max_frames = 0;
   posefuse::ImuNoise noise;  // the EuRoC IMU's datasheet figures (imu0 sensor.yaml)
+  posefuse::ImuReadOptions imu_bounds;
+  double outside_margin_px = 1.0;
   bool json = false;
 };
 
@@ -90,33 +95,36 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   std::optional<std::filesystem::path> tracks, camera, imu;
   apps::Parser cli(cmd.program, "--tracks FILE --camera FILE --imu FILE [options]",
                    "Sliding-window visual-inertial odometry on feature tracks.");
-  cli.path({.name = "--tracks", .value = "FILE", .help = "feature tracks t_ns,feature_id,u,v (required)"}, tracks);
-  cli.path({.name = "--camera", .value = "FILE", .help = "EuRoC camera sensor.yaml (required)"}, camera);
-  cli.path({.name = "--imu", .value = "FILE", .help = "EuRoC imu0.csv (required)"}, imu);
-  cli.path({.name = "--groundtruth", .value = "FILE", .help = "EuRoC ground truth csv: print the errors"},
+  cli.input({.name = "--tracks", .value = "FILE", .help = "feature tracks t_ns,feature_id,u,v (required)"}, tracks);
+  cli.input({.name = "--camera", .value = "FILE", .help = "EuRoC camera sensor.yaml (required)"}, camera);
+  cli.input({.name = "--imu", .value = "FILE", .help = "EuRoC imu0.csv (required)"}, imu);
+  cli.input({.name = "--groundtruth", .value = "FILE", .help = "EuRoC ground truth csv: print the errors"},
            o.groundtruth);
-  cli.path({.name = "--out", .value = "FILE", .help = "write the trajectory (TUM; loop-corrected with --loops)"},
+  cli.output({.name = "--out", .value = "FILE", .help = "write the trajectory (TUM; loop-corrected with --loops)"},
            o.out);
-  cli.path({.name = "--out-odometry", .value = "FILE", .help = "write the odometry without loop correction (TUM)"},
+  cli.output({.name = "--out-odometry", .value = "FILE", .help = "write the odometry without loop correction (TUM)"},
            o.out_odometry);
   cli.custom({.name = "--loops", .value = "FILE|recurring-ids",
               .help = "loop candidates: a t_ns_query,t_ns_match csv, or from recurring feature ids\n"
-                      "(an oracle: simulated tracks with --recurring-ids only)"},
+                      "(an oracle: simulated tracks with --recurring-ids only)",
+              .role = apps::PathRole::kInput,
+              .keywords = {"recurring-ids"}},
              [&](std::string_view v) {
                if (v.empty()) throw apps::usage_error("expected a file or recurring-ids, got ''");
                o.loops = std::string(v);
              });
-  cli.path({.name = "--save-map", .value = "FILE", .help = "write the keyframe graph as a map (needs --loops)"},
+  cli.output({.name = "--save-map", .value = "FILE", .help = "write the keyframe graph as a map (needs --loops)"},
            o.save_map);
-  cli.path({.name = "--load-map", .value = "FILE", .help = "localise in a saved map (needs --loops)"}, o.load_map);
-  cli.real({.name = "--max-imu-gap-ms", .value = "MS", .help = "longest accepted IMU gap",
-            .default_text = "50"},
-           o.max_imu_gap_ms, apps::Domain::kPositive);
-  cli.real({.name = "--pixel-sigma", .value = "PX", .help = "pixel noise of the tracks (1 sigma)",
-            .default_text = "1"},
-           o.pixel_sigma_px, apps::Domain::kPositive);
-  cli.integer({.name = "--window", .value = "N", .help = "keyframes in the window", .default_text = "10"},
-              o.window, 2, 100);
+  cli.input({.name = "--load-map", .value = "FILE", .help = "localise in a saved map (needs --loops)"}, o.load_map);
+  cli.real_in({.name = "--max-imu-gap-ms", .value = "MS", .help = "longest accepted IMU gap", .unit = "ms"},
+              o.max_imu_gap_ms, 0.01, 1e4);
+  cli.real_in({.name = "--pixel-sigma", .value = "PX", .help = "pixel noise of the tracks (1 sigma)", .unit = "px"},
+              o.pixel_sigma_px, 0.01, 100.0);
+  cli.integer({.name = "--window", .value = "N",
+               .help = "keyframes in the window, 2 to 40; the solve's time per frame\n"
+                       "grows faster than N (at 40, far slower than real time on EuRoC)",
+               .default_text = "10"},
+              o.window, 2, 40);
   cli.integer({.name = "--iterations", .value = "N", .help = "LM iterations per frame (cap)",
                .default_text = "10"},
               o.iterations, 1, 1000);
@@ -135,11 +143,16 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   cli.flag({.name = "--no-track-reuse",
             .help = "do not re-anchor the tracks of a marginalised keyframe's features"},
            o.no_reuse);
-  cli.real({.name = "--min-parallax", .value = "PX", .help = "keyframe parallax", .default_text = "10"},
-           o.min_parallax_px, apps::Domain::kPositive);
-  cli.real({.name = "--outlier-px", .value = "PX", .help = "reprojection error of an outlier",
-            .default_text = "5.26"},
-           o.outlier_px, apps::Domain::kPositive);
+  cli.real_in({.name = "--min-parallax", .value = "PX", .help = "keyframe parallax", .unit = "px"},
+              o.min_parallax_px, 0.1, 1000.0);
+  cli.real_in({.name = "--outlier-px", .value = "PX", .help = "reprojection error of an outlier (>= --pixel-sigma)",
+               .unit = "px"},
+              o.outlier_px, 0.01, 1000.0);
+  cli.real_in({.name = "--outside-margin", .value = "PX",
+               .help = "observations outside the image by at most this much are\n"
+                       "dropped (counted, with a warning); farther out they are refused",
+               .unit = "px"},
+              o.outside_margin_px, 0.0, 10.0);
   cli.custom({.name = "--imu-noise", .value = "NA,NG,WA,WG",
               .help = "accelerometer and gyroscope noise densities, then their random walks\n"
                       "(m/s^2/sqrt(Hz), rad/s/sqrt(Hz), m/s^3/sqrt(Hz), rad/s^2/sqrt(Hz))",
@@ -152,16 +165,24 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
                  if (comma == std::string_view::npos || (i == 3 && v.find(',', start) != std::string_view::npos))
                    throw apps::usage_error("expected four comma-separated numbers, got '" + std::string(v) + "'");
                  x[i] = apps::parse_real(v.substr(start, comma - start), apps::Domain::kPositive);
+                 // A density this small or large makes the IMU's information
+                 // overflow or vanish: it can only fail.
+                 if (!(x[i] >= 1e-8 && x[i] <= 100.0))
+                   throw apps::usage_error("each value must be from 1e-08 to 100, got '" + std::string(v) + "'");
                  start = comma + 1;
                }
                o.noise = posefuse::ImuNoise{x[1], x[0], x[3], x[2]};
              });
   cli.integer({.name = "--max-frames", .value = "N", .help = "stop after N frames (0: all)"}, o.max_frames,
               std::size_t{0});
+  apps::declare_imu_bounds(cli, o.imu_bounds);
   cli.flag({.name = "--json", .help = "print one JSON object instead of the table"}, o.json);
   cli.epilogue("Exit status: 0 ok, 1 bad data (file:line where a file is at fault), 2 bad usage.");
   if (!cli.parse(cmd)) return std::nullopt;
   if (!tracks || !camera || !imu) throw apps::usage_error("--tracks, --camera and --imu are required");
+  if (o.outlier_px < o.pixel_sigma_px)
+    throw apps::usage_error("--outlier-px " + apps::num(o.outlier_px) + " is below --pixel-sigma " +
+                            apps::num(o.pixel_sigma_px) + ": most true observations would be rejected");
   if ((o.save_map || o.load_map) && !o.loops) throw apps::usage_error("--save-map and --load-map need --loops");
   o.tracks = *tracks;
   o.camera = *camera;
@@ -191,6 +212,9 @@ struct Summary {
   std::vector<Jump> jumps;
   posefuse::Statistics ape_odometry, ape_keyframes;
   bool have_keyframe_ape = false;
+  std::size_t dropped = 0;   // observations outside the image, dropped
+  bool vision = true;        // some estimated frame used a visual feature
+  bool yaw_defined = true;   // the ground truth moves enough to define the alignment's yaw
 };
 
 double yaw_error_deg(const Eigen::Matrix3d& R_ref, const Eigen::Matrix3d& R_est) {
@@ -198,12 +222,61 @@ double yaw_error_deg(const Eigen::Matrix3d& R_ref, const Eigen::Matrix3d& R_est)
   return std::atan2(E(1, 0) - E(0, 1), E(0, 0) + E(1, 1)) * 180.0 / std::numbers::pi;
 }
 
+// The ground truth's poses within 10 ms of the estimated frames; at least 3.
+// @throws posefuse::io_error naming the ground-truth file otherwise
+posefuse::Association associate_groundtruth(const std::filesystem::path& file, const posefuse::Trajectory& gt,
+                                            const posefuse::Trajectory& traj) {
+  const auto span = [](const posefuse::Trajectory& t) {
+    return posefuse::detail::traj_io::format_number(t.t_s.front()) + " to " +
+           posefuse::detail::traj_io::format_number(t.t_s.back()) + " s";
+  };
+  posefuse::Association a;
+  try {
+    a = posefuse::associate(gt.t_s, traj.t_s, 0.01, 0.0);
+  } catch (const posefuse::invalid_argument&) {
+    a = {};
+  }
+  if (a.size() < 3)
+    throw posefuse::io_error(file, std::to_string(a.size()) + " poses within 10 ms of an estimated frame (the ground "
+                                   "truth spans " + span(gt) + ", the estimate " + span(traj) +
+                                   "); the errors need at least 3");
+  return a;
+}
+
+// APE of the positions after `alignment`; a ground truth whose matched
+// positions cannot be aligned (all on one line for SE(3)) is named.
+posefuse::MetricResult aligned_ape(const std::filesystem::path& file, const posefuse::Trajectory& ref,
+                                   const posefuse::Trajectory& est, posefuse::Alignment alignment) {
+  try {
+    return posefuse::ape(ref, est, posefuse::PoseRelation::kTranslation, alignment);
+  } catch (const posefuse::invalid_argument&) {
+    throw posefuse::io_error(file, "the " + std::to_string(ref.size()) +
+                                       " matched ground-truth positions cannot be aligned with the estimate (" +
+                                       (alignment == posefuse::Alignment::kSE3 ? "SE(3)" : "position + yaw") +
+                                       " needs positions that do not all lie on one point or line)");
+  }
+}
+
 // APE position+yaw of `traj` against the ground truth (associated within 10 ms).
-posefuse::Statistics ape_posyaw(const posefuse::EurocGroundTruth& gt, const posefuse::Trajectory& traj) {
-  const posefuse::Association a = posefuse::associate(gt.trajectory.t_s, traj.t_s, 0.01, 0.0);
-  return posefuse::ape(posefuse::select(gt.trajectory, a.ref_ids), posefuse::select(traj, a.est_ids),
-                       posefuse::PoseRelation::kTranslation, posefuse::Alignment::kPosYaw)
+posefuse::Statistics ape_posyaw(const std::filesystem::path& file, const posefuse::EurocGroundTruth& gt,
+                                const posefuse::Trajectory& traj) {
+  const posefuse::Association a = associate_groundtruth(file, gt.trajectory, traj);
+  return aligned_ape(file, posefuse::select(gt.trajectory, a.ref_ids), posefuse::select(traj, a.est_ids),
+                     posefuse::Alignment::kPosYaw)
       .stats;
+}
+
+// Below this horizontal extent (m, largest distance of a position from the
+// mean in x-y) the yaw of a position + yaw alignment is not defined.
+constexpr double kMinYawExtentM = 0.1;
+
+double horizontal_extent(const posefuse::Trajectory& t) {
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const Eigen::Isometry3d& T : t.poses) mean += T.translation().head<2>();
+  mean /= double(t.size());
+  double r = 0;
+  for (const Eigen::Isometry3d& T : t.poses) r = std::max(r, (T.translation().head<2>() - mean).norm());
+  return r;
 }
 
 // The loop-closure side of a run: the database, the candidates still to
@@ -292,11 +365,23 @@ class Loops {
   bool have_last_ = false;
 };
 
-int run(const Options& o) {
+int run(const Options& o, const std::string& program) {
+  apps::TerminalProgress progress(program);
+  progress.stage("reading " + o.tracks.string());
   const posefuse::PinholeRadtan cam = posefuse::read_euroc_camera(o.camera);
-  const posefuse::FeatureTracks tracks = posefuse::read_feature_tracks(o.tracks, cam);
-  const std::vector<posefuse::ImuSample> imu =
-      posefuse::read_euroc_imu_checked(o.imu, std::int64_t(std::llround(o.max_imu_gap_ms * 1e6)));
+  const posefuse::FeatureTrackRead track_read = posefuse::read_feature_tracks_counted(
+      o.tracks, posefuse::FeatureTrackReadOptions{cam.width, cam.height, o.outside_margin_px});
+  const posefuse::FeatureTracks& tracks = track_read.tracks;
+  progress.clear();
+  if (track_read.dropped > 0)
+    std::fprintf(stderr,
+                 "warning: %s: dropped %zu observations outside the %dx%d image by up to %s px (first on line "
+                 "%zu; --outside-margin %s px)\n",
+                 o.tracks.string().c_str(), track_read.dropped, cam.width, cam.height,
+                 apps::num(track_read.worst_outside_px).c_str(), track_read.first_dropped_line,
+                 apps::num(o.outside_margin_px).c_str());
+  const std::vector<posefuse::ImuSample> imu = posefuse::read_euroc_imu_checked(
+      o.imu, std::int64_t(std::llround(o.max_imu_gap_ms * 1e6)), o.imu_bounds);
   std::optional<posefuse::EurocGroundTruth> gt;
   if (o.groundtruth) gt = posefuse::read_euroc_groundtruth(*o.groundtruth);
   if (imu.empty()) throw apps::data_error(o.imu.string() + ": no IMU sample");
@@ -318,6 +403,7 @@ int run(const Options& o) {
   if (o.estimate_extrinsic) est.set_estimate_extrinsic(true);
 
   Summary s;
+  s.dropped = track_read.dropped;
   std::optional<Loops> loops;
   if (o.loops) {
     loops.emplace(o, tracks, s);
@@ -325,9 +411,9 @@ int run(const Options& o) {
   }
   posefuse::Trajectory traj, odometry;
   std::vector<posefuse::ImuState> states;
-  const bool progress = !o.json && isatty(STDERR_FILENO);
   std::size_t k = 0;
   double total_ms = 0;
+  long long visual_features = 0;  // triangulated features over the estimated frames
   for (std::size_t f = 0; f < tracks.size(); ++f) {
     if (o.max_frames > 0 && f >= o.max_frames) break;
     const posefuse::TrackFrame& frame = tracks[f];
@@ -343,6 +429,7 @@ int run(const Options& o) {
     if (r.status == posefuse::VioStatus::kInitializing) continue;
     total_ms += ms;
     s.ms_max = std::max(s.ms_max, ms);
+    visual_features += r.features;
     const posefuse::SE3d T(r.state.p, r.state.R);
     if (!T.translation().allFinite() || !T.so3().quaternion().coeffs().allFinite())
       throw apps::data_error("a non-finite state at t = " + std::to_string(frame.t_ns) + " ns");
@@ -350,10 +437,12 @@ int run(const Options& o) {
     odometry.push_back(t_s, T.isometry());
     traj.push_back(t_s, (loops ? loops->correct(T, t_s) : T).isometry());
     states.push_back(r.state);
-    if (progress && f % 20 == 0)
-      std::fprintf(stderr, "\rframe %zu / %zu  (%s)   ", f + 1, tracks.size(), posefuse::to_string(r.status));
+    progress.update([&] {
+      return "frame " + std::to_string(f + 1) + "/" + std::to_string(tracks.size()) + "  (" +
+             posefuse::to_string(r.status) + ")";
+    });
   }
-  if (progress) std::fprintf(stderr, "\r%60s\r", "");
+  progress.clear();
   std::int64_t last_frame_ns = 0;
   if (s.frames > 0) last_frame_ns = tracks[s.frames - 1].t_ns;
   if (loops) loops->finish(last_frame_ns);
@@ -363,25 +452,33 @@ int run(const Options& o) {
   s.processing_s = total_ms * 1e-3;
   s.duration_s = traj.t_s.back() - traj.t_s.front();
 
-  apps::OutputFiles files;
-  if (o.out) files.add_with(*o.out, [&](const std::filesystem::path& p) { posefuse::write_tum(p, traj); });
-  if (o.out_odometry)
-    files.add_with(*o.out_odometry, [&](const std::filesystem::path& p) { posefuse::write_tum(p, odometry); });
-  if (o.save_map)
-    files.add_with(*o.save_map,
-                   [&](const std::filesystem::path& p) { posefuse::save_vio_map(p, loops->closure().to_map()); });
-  files.commit();
+  s.vision = visual_features > 0;
+  if (!s.vision)
+    std::fprintf(stderr,
+                 "warning: no estimated frame used a visual feature (none was triangulated or every one was "
+                 "rejected): the trajectory is the IMU's alone; check --pixel-sigma, --outlier-px and %s\n",
+                 o.tracks.string().c_str());
 
+  // Every figure is computed before any output is written: a ground truth
+  // that cannot be compared with the run (no pose in time, fewer than 3)
+  // fails the run (exit 1) and writes nothing.
   if (gt) {
-    const posefuse::Association a = posefuse::associate(gt->trajectory.t_s, traj.t_s, 0.01, 0.0);
+    const posefuse::Association a = associate_groundtruth(*o.groundtruth, gt->trajectory, traj);
     s.have_gt = true;
     s.matched = a.size();
     const posefuse::Trajectory ref = posefuse::select(gt->trajectory, a.ref_ids);
     const posefuse::Trajectory es = posefuse::select(traj, a.est_ids);
-    const posefuse::MetricResult py =
-        posefuse::ape(ref, es, posefuse::PoseRelation::kTranslation, posefuse::Alignment::kPosYaw);
+    const posefuse::MetricResult py = aligned_ape(*o.groundtruth, ref, es, posefuse::Alignment::kPosYaw);
     s.ape_posyaw = py.stats;
-    s.ape_se3 = posefuse::ape(ref, es, posefuse::PoseRelation::kTranslation, posefuse::Alignment::kSE3).stats;
+    s.ape_se3 = aligned_ape(*o.groundtruth, ref, es, posefuse::Alignment::kSE3).stats;
+    // A position + yaw alignment of points that do not move horizontally has
+    // no defined yaw: the yaw errors would be arbitrary.
+    s.yaw_defined = horizontal_extent(ref) >= kMinYawExtentM;
+    if (!s.yaw_defined)
+      std::fprintf(stderr,
+                   "warning: %s: the matched ground-truth positions stay within %s m horizontally; the "
+                   "alignment's yaw is not defined, so no yaw error is given\n",
+                   o.groundtruth->string().c_str(), apps::num(kMinYawExtentM).c_str());
     try {
       posefuse::RpeOptions ro;
       ro.delta = 10.0;
@@ -413,7 +510,7 @@ int run(const Options& o) {
       s.accel_bias_rms = std::sqrt(sa / double(a.size()));
     }
     if (loops) {
-      s.ape_odometry = ape_posyaw(*gt, odometry);
+      s.ape_odometry = ape_posyaw(*o.groundtruth, *gt, odometry);
       // The live sequence's keyframes at their final graph poses.
       posefuse::Trajectory kf;
       const posefuse::LoopClosure& lc = loops->closure();
@@ -421,16 +518,26 @@ int run(const Options& o) {
         if (x.sequence == lc.live_sequence())
           kf.push_back(posefuse::seconds_from_ns(x.record.t_ns), lc.corrected_pose(x.id).isometry());
       if (kf.size() >= 3) {
-        s.ape_keyframes = ape_posyaw(*gt, kf);
+        s.ape_keyframes = ape_posyaw(*o.groundtruth, *gt, kf);
         s.have_keyframe_ape = true;
       }
     }
   }
 
+  apps::OutputFiles files;
+  if (o.out) files.add_with(*o.out, [&](const std::filesystem::path& p) { posefuse::write_tum(p, traj); });
+  if (o.out_odometry)
+    files.add_with(*o.out_odometry, [&](const std::filesystem::path& p) { posefuse::write_tum(p, odometry); });
+  if (o.save_map)
+    files.add_with(*o.save_map,
+                   [&](const std::filesystem::path& p) { posefuse::save_vio_map(p, loops->closure().to_map()); });
+  files.commit();
+
   if (o.json) {
     apps::JsonWriter j(std::cout);
     j.begin_object(apps::JsonWriter::Layout::kBlock);
     j.member("frames", s.frames).member("written", s.written);
+    j.member("observations_dropped_outside_image", s.dropped).member("vision_used", s.vision);
     j.key("statuses").begin_object(apps::JsonWriter::Layout::kInline);
     for (const auto& [name, n] : s.statuses) j.member(name, n);
     j.end_object();
@@ -459,7 +566,12 @@ int run(const Options& o) {
         if (s.have_keyframe_ape) j.member("ape_posyaw_keyframes_graph_rmse_m", s.ape_keyframes.rmse);
       }
       if (s.have_rpe) j.member("rpe_10m_rmse_m", s.rpe10.rmse);
-      j.member("final_yaw_error_deg", s.final_yaw_error_deg).member("max_yaw_error_deg", s.max_yaw_error_deg);
+      if (s.yaw_defined) {
+        j.member("final_yaw_error_deg", s.final_yaw_error_deg).member("max_yaw_error_deg", s.max_yaw_error_deg);
+      } else {
+        j.key("final_yaw_error_deg").null();
+        j.key("max_yaw_error_deg").null();
+      }
       if (s.have_bias) {
         j.member("gyro_bias_error_rms_radps", s.gyro_bias_rms).member("gyro_bias_error_final_radps", s.gyro_bias_final);
         j.member("accel_bias_error_rms_mps2", s.accel_bias_rms).member("accel_bias_error_final_mps2", s.accel_bias_final);
@@ -469,6 +581,8 @@ int run(const Options& o) {
     return 0;
   }
   std::printf("frames                 %zu (%zu estimated)\n", s.frames, s.written);
+  if (s.dropped > 0) std::printf("dropped                %zu observations outside the image\n", s.dropped);
+  if (!s.vision) std::printf("vision                 not used: IMU only\n");
   std::printf("status               ");
   for (const auto& [name, n] : s.statuses) std::printf("  %s %d", name.c_str(), n);
   std::printf("\n");
@@ -495,8 +609,11 @@ int run(const Options& o) {
                 s.matched, s.loops ? ", written with loop correction" : "");
     std::printf("APE SE(3)              rmse %.4f m, max %.4f m\n", s.ape_se3.rmse, s.ape_se3.max);
     if (s.have_rpe) std::printf("RPE per 10 m           rmse %.4f m\n", s.rpe10.rmse);
-    std::printf("yaw error              final %.3f deg, max %.3f deg (after position+yaw alignment)\n",
-                s.final_yaw_error_deg, s.max_yaw_error_deg);
+    if (s.yaw_defined)
+      std::printf("yaw error              final %.3f deg, max %.3f deg (after position+yaw alignment)\n",
+                  s.final_yaw_error_deg, s.max_yaw_error_deg);
+    else
+      std::printf("yaw error              not defined (the ground truth does not move horizontally)\n");
     if (s.have_bias) {
       std::printf("gyro bias error        rms %.5f rad/s, final %.5f rad/s\n", s.gyro_bias_rms, s.gyro_bias_final);
       std::printf("accel bias error       rms %.4f m/s^2, final %.4f m/s^2\n", s.accel_bias_rms, s.accel_bias_final);
@@ -510,6 +627,6 @@ int run(const Options& o) {
 int main(int argc, char** argv) {
   return apps::run_main(argc, argv, [](const apps::CommandLine& cmd) {
     const std::optional<Options> o = parse_options(cmd);
-    return o ? run(*o) : 0;
+    return o ? run(*o, cmd.program) : 0;
   });
 }

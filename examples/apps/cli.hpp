@@ -43,6 +43,7 @@
 #include <vector>
 
 #include <posefuse/core/error.hpp>
+#include <posefuse/io/detail/message_number.hpp>
 
 namespace posefuse::apps {
 
@@ -131,6 +132,77 @@ template <std::integral T>
   return std::string(buf, ptr);
 }
 
+/// A number for a message (error, warning, `--help`): posefuse's one
+/// message formatter, see posefuse::detail::message_number ("105" for
+/// 104.99993599999999, "1e-09" for 1e-9).
+[[nodiscard]] inline std::string num(double v) { return posefuse::detail::message_number(v); }
+
+/// What a path-valued flag names: the parser refuses (usage_error) an output
+/// that names an input file or folder, and two outputs that name one file.
+enum class PathRole {
+  kInput,   ///< read by the run (a file or a folder)
+  kOutput,  ///< written by the run (a file or a folder)
+};
+
+/// The file or folder `p` names, for comparing two paths: absolute, with the
+/// symbolic links of its existing part resolved, normalised, without a
+/// trailing separator (`./t.csv`, `t.csv` and `dir/../t.csv` give one key).
+[[nodiscard]] inline std::filesystem::path path_key(const std::filesystem::path& p) {
+  std::error_code ec;
+  std::filesystem::path k = std::filesystem::weakly_canonical(std::filesystem::absolute(p, ec), ec);
+  if (ec) k = std::filesystem::absolute(p, ec);
+  k = k.lexically_normal();
+  if (!k.has_filename() && k.has_parent_path()) k = k.parent_path();
+  return k;
+}
+
+/// True when `a` and `b` name one file or folder: the same file when both
+/// exist (hard links too), else the same path_key.
+[[nodiscard]] inline bool same_file(const std::filesystem::path& a, const std::filesystem::path& b) {
+  std::error_code ec;
+  if (std::filesystem::exists(a, ec) && std::filesystem::exists(b, ec)) {
+    const bool eq = std::filesystem::equivalent(a, b, ec);
+    if (!ec) return eq;
+  }
+  return path_key(a) == path_key(b);
+}
+
+/// True for an output that replaces no file when written: an existing
+/// device or pipe (`/dev/null`, `/dev/stdout`, a FIFO) or a path under /dev.
+[[nodiscard]] inline bool writes_no_file(const std::filesystem::path& out) {
+  std::error_code ec;
+  const std::filesystem::file_status st = std::filesystem::status(out, ec);
+  if (std::filesystem::exists(st) && !std::filesystem::is_regular_file(st) &&
+      !std::filesystem::is_directory(st))
+    return true;
+  const std::filesystem::path k = path_key(out);
+  auto it = k.begin();
+  return it != k.end() && *it == "/" && ++it != k.end() && *it == "dev";
+}
+
+/// Refuses (usage_error, exit 2) an output that names an input (writing it
+/// would replace the input) and two outputs that name one file (one would
+/// replace the other). Parser::parse calls it for the flags declared with a
+/// PathRole; a program calls it itself only for paths it derives.
+/// @param[in] outputs (flag, path) of each output given
+/// @param[in] inputs  (flag, path) of each input given
+inline void refuse_output_over_input(
+    const std::vector<std::pair<std::string, std::filesystem::path>>& outputs,
+    const std::vector<std::pair<std::string, std::filesystem::path>>& inputs) {
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    const auto& [out_flag, out] = outputs[i];
+    if (writes_no_file(out)) continue;
+    for (const auto& [in_flag, in] : inputs)
+      if (same_file(out, in))
+        throw usage_error(out_flag + " " + out.string() + " is the input of " + in_flag +
+                          "; it would be overwritten");
+    for (std::size_t j = 0; j < i; ++j)
+      if (same_file(out, outputs[j].second))
+        throw usage_error(outputs[j].first + " " + outputs[j].second.string() + " and " + out_flag + " " +
+                          out.string() + " name the same file; one would overwrite the other");
+  }
+}
+
 /// The command line of one run.
 struct CommandLine {
   std::string program;            ///< file name of argv[0] ("program" when absent)
@@ -154,6 +226,12 @@ struct FlagSpec {
   std::string help{};        ///< one line; '\n' starts an indented continuation line
   std::string default_text{};  ///< shown as "(default ...)"; filled in from the target when empty
   std::string unit{};        ///< appended to an automatic default ("0.01 s")
+  /// For a custom flag whose value is a path (or a keyword): its role in the
+  /// output-over-input check. input(), inputs() and output() set it.
+  std::optional<PathRole> role{};
+  /// Values of a custom flag with a role that are keywords, not paths
+  /// ("recurring-ids").
+  std::vector<std::string> keywords{};
 };
 
 /// A declarative command-line parser: flags are declared with the variable
@@ -191,20 +269,27 @@ class Parser {
     return add(std::move(spec), false, [&target](std::string_view v) { target = std::string(v); });
   }
 
-  /// A path, absent unless given.
-  Parser& path(FlagSpec spec, std::optional<std::filesystem::path>& target) {
-    return add(std::move(spec), false, [&target](std::string_view v) {
-      if (v.empty()) throw usage_error("expected a path, got ''");
-      target = std::filesystem::path(v);
-    });
+  /// An input path (file or folder), absent unless given. Every path flag is
+  /// declared as an input or an output, and parse() refuses an output that
+  /// names an input or another output (refuse_output_over_input).
+  Parser& input(FlagSpec spec, std::optional<std::filesystem::path>& target) {
+    spec.role = PathRole::kInput;
+    return add(std::move(spec), false, path_setter(target));
   }
 
-  /// A repeatable path: every occurrence is appended, in order.
-  Parser& paths(FlagSpec spec, std::vector<std::filesystem::path>& target) {
+  /// A repeatable input path: every occurrence is appended, in order.
+  Parser& inputs(FlagSpec spec, std::vector<std::filesystem::path>& target) {
+    spec.role = PathRole::kInput;
     return add(std::move(spec), true, [&target](std::string_view v) {
       if (v.empty()) throw usage_error("expected a path, got ''");
       target.emplace_back(v);
     });
+  }
+
+  /// An output path (file or folder), absent unless given; see input().
+  Parser& output(FlagSpec spec, std::optional<std::filesystem::path>& target) {
+    spec.role = PathRole::kOutput;
+    return add(std::move(spec), false, path_setter(target));
   }
 
   /// A real number in `domain` (see parse_real).
@@ -213,6 +298,20 @@ class Parser {
       spec.default_text = shortest(target) + (spec.unit.empty() ? "" : " " + spec.unit);
     return add(std::move(spec), false,
                [&target, domain](std::string_view v) { target = parse_real(v, domain); });
+  }
+
+  /// A real number in [lo, hi]: for a value that can only fail (or do
+  /// nothing) outside that range; `--help` shows the range.
+  Parser& real_in(FlagSpec spec, double& target, double lo, double hi) {
+    if (spec.default_text.empty())
+      spec.default_text = num(target) + (spec.unit.empty() ? "" : " " + spec.unit);
+    spec.help += "; " + num(lo) + " to " + num(hi);
+    return add(std::move(spec), false, [&target, lo, hi](std::string_view v) {
+      const double x = parse_real(v);
+      if (!(x >= lo && x <= hi))
+        throw usage_error("expected a number from " + num(lo) + " to " + num(hi) + ", got '" + std::string(v) + "'");
+      target = x;
+    });
   }
 
   /// An integer in [lo, hi], absent unless given (see parse_integer).
@@ -256,7 +355,10 @@ class Parser {
         return false;
       }
     }
-    for (Flag& f : flags_) f.count = 0;
+    for (Flag& f : flags_) {
+      f.count = 0;
+      f.values.clear();
+    }
     for (std::size_t i = 0; i < cmd.args.size(); ++i) {
       const std::string_view arg = cmd.args[i];
       if (arg.substr(0, 2) != "--" || arg.size() == 2)
@@ -285,8 +387,23 @@ class Parser {
       } catch (const std::invalid_argument& e) {  // also posefuse::invalid_argument
         throw usage_error(std::string(name) + ": " + e.what());
       }
+      f->values.emplace_back(value);
     }
+    check_paths();
     return true;
+  }
+
+  /// (flag, path) of every path given to a flag declared with `role`, in
+  /// the order of declaration.
+  [[nodiscard]] std::vector<std::pair<std::string, std::filesystem::path>> paths_given(PathRole role) const {
+    std::vector<std::pair<std::string, std::filesystem::path>> out;
+    for (const Flag& f : flags_) {
+      if (f.spec.role != role) continue;
+      for (const std::string& v : f.values)
+        if (std::find(f.spec.keywords.begin(), f.spec.keywords.end(), v) == f.spec.keywords.end())
+          out.emplace_back(f.spec.name, std::filesystem::path(v));
+    }
+    return out;
   }
 
   /// True when the last parse saw flag `name`.
@@ -338,13 +455,25 @@ class Parser {
     bool repeatable = false;
     std::function<void(std::string_view)> apply;
     int count = 0;
+    std::vector<std::string> values{};  ///< as given, in order
   };
+
+  static std::function<void(std::string_view)> path_setter(std::optional<std::filesystem::path>& target) {
+    return [&target](std::string_view v) {
+      if (v.empty()) throw usage_error("expected a path, got ''");
+      target = std::filesystem::path(v);
+    };
+  }
+
+  void check_paths() const {
+    refuse_output_over_input(paths_given(PathRole::kOutput), paths_given(PathRole::kInput));
+  }
 
   Parser& add(FlagSpec spec, bool repeatable, std::function<void(std::string_view)> apply) {
     if (spec.name.size() < 3 || spec.name.rfind("--", 0) != 0 || spec.name == "--help" ||
         spec.name.find('=') != std::string::npos || find(spec.name) != nullptr)
       throw std::logic_error("Parser: bad or duplicate flag name '" + spec.name + "'");
-    flags_.push_back({std::move(spec), repeatable, std::move(apply), 0});
+    flags_.push_back({std::move(spec), repeatable, std::move(apply), 0, {}});
     return *this;
   }
 

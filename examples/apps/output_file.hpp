@@ -224,7 +224,7 @@ class OutputFiles {
   void push(const std::filesystem::path& file, FileWriter write, bool folder) {
     const std::filesystem::path target = detail::resolve_target(file);
     for (const Entry& e : entries_)
-      if (e.target == target)
+      if (e.target == target && !writes_no_file(target))
         throw invalid_argument(file.string() + " is given as two outputs of one run");
     entries_.push_back({file, target, std::move(write), folder, false, {}});
   }
@@ -240,25 +240,5 @@ class OutputFiles {
 
   std::vector<Entry> entries_;
 };
-
-/// Refuses (usage_error, exit 2) an output path that names an input file:
-/// writing it would replace the input. Paths are compared as the files they
-/// name (hard links, `./a` and `a`), or lexically when the output does not
-/// exist yet.
-/// @param[in] outputs (flag, path) of each output given
-/// @param[in] inputs  (flag, path) of each input given
-inline void refuse_output_over_input(
-    const std::vector<std::pair<std::string, std::filesystem::path>>& outputs,
-    const std::vector<std::pair<std::string, std::filesystem::path>>& inputs) {
-  for (const auto& [out_flag, out] : outputs)
-    for (const auto& [in_flag, in] : inputs) {
-      std::error_code ec;
-      const bool same = std::filesystem::exists(out, ec)
-                            ? std::filesystem::equivalent(out, in, ec)
-                            : std::filesystem::weakly_canonical(out, ec) == std::filesystem::weakly_canonical(in, ec);
-      if (same && !ec)
-        throw usage_error(out_flag + " " + out.string() + " is the input of " + in_flag + "; it would be overwritten");
-    }
-}
 
 }  // namespace posefuse::apps

@@ -19,6 +19,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <string>
@@ -26,6 +27,7 @@
 #include <unistd.h>
 #include <vector>
 
+#include "examples/program_probe.hpp"
 #include "support/run_program.hpp"
 #include "support/temp_dir.hpp"
 
@@ -114,8 +116,8 @@ TEST_CASE("apps::Parser: every kind of flag sets its target", "[examples][cli]")
   std::string mode;
   apps::Parser cli("prog", "[options]", "A test program.");
   cli.text({.name = "--name", .value = "TEXT", .help = "a name"}, name);
-  cli.path({.name = "--file", .value = "FILE", .help = "a file"}, file);
-  cli.paths({.name = "--input", .value = "FILE", .help = "inputs (repeat)"}, inputs);
+  cli.output({.name = "--file", .value = "FILE", .help = "a file"}, file);
+  cli.inputs({.name = "--input", .value = "FILE", .help = "inputs (repeat)"}, inputs);
   cli.real({.name = "--sigma", .value = "S", .help = "noise", .unit = "m"}, sigma, apps::Domain::kPositive);
   cli.integer({.name = "--seed", .value = "N", .help = "seed"}, seed, std::uint64_t{0});
   cli.integer({.name = "--count", .value = "K", .help = "count"}, count, 1, 10);
@@ -200,7 +202,7 @@ TEST_CASE("apps::Parser: each usage mistake is a usage_error naming it", "[examp
   cli.real({.name = "--tol", .value = "S", .help = "tolerance"}, tol, apps::Domain::kNonNegative);
   cli.integer({.name = "--seed", .value = "N", .help = "seed"}, seed, std::uint64_t{0});
   cli.integer({.name = "--k", .value = "K", .help = "k"}, k, -3, 7);
-  cli.path({.name = "--file", .value = "FILE", .help = "file"}, file);
+  cli.input({.name = "--file", .value = "FILE", .help = "file"}, file);
   cli.flag({.name = "--json", .help = "json"}, json);
   cli.custom({.name = "--mode", .value = "a|b", .help = "mode"}, [&](std::string_view v) {
     if (v != "a" && v != "b") throw posefuse::invalid_argument("unknown mode '" + std::string(v) + "'");
@@ -265,6 +267,79 @@ TEST_CASE("apps::Parser: each usage mistake is a usage_error naming it", "[examp
   CHECK(usage_message(cli, {"--file=--odd-name"}).empty());  // the = form takes any value
   REQUIRE(file);
   CHECK(*file == "--odd-name");
+}
+
+TEST_CASE("apps::Parser: an output naming an input or another output is a usage error",
+          "[examples][cli][outputs]") {
+  const posefuse::test::TempDir dir("cli-roles");
+  const fs::path in = dir.write("in.csv", "1\n");
+  fs::create_directory(dir.path() / "sub");
+  fs::create_symlink(in, dir.path() / "link.csv");
+  const auto parse = [&](std::vector<std::string> args) {
+    std::optional<fs::path> input, out, svg;
+    std::vector<fs::path> more;
+    std::string loops;
+    apps::Parser cli("prog", "", "");
+    cli.input({.name = "--in", .value = "FILE", .help = "input"}, input);
+    cli.inputs({.name = "--more", .value = "FILE", .help = "inputs"}, more);
+    cli.output({.name = "--out", .value = "FILE", .help = "output"}, out);
+    cli.output({.name = "--svg", .value = "FILE", .help = "plot"}, svg);
+    cli.custom({.name = "--loops", .value = "FILE|auto", .help = "a file or auto",
+                .role = apps::PathRole::kInput, .keywords = {"auto"}},
+               [&](std::string_view v) { loops = std::string(v); });
+    for (std::string& a : args) a = posefuse::test::expand(a, dir);
+    std::ostringstream help;
+    return cli.parse(command(args), help);
+  };
+  const auto refused = [&](std::vector<std::string> args) {
+    try {
+      (void)parse(std::move(args));
+    } catch (const apps::usage_error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const std::string d = dir.path().string();
+  // Spellings of one file: ./, dir/../, a symbolic link, a trailing separator.
+  CHECK(refused({"--in", "{dir}/in.csv", "--out", "{dir}/./in.csv"}) ==
+        "--out " + d + "/./in.csv is the input of --in; it would be overwritten");
+  CHECK(refused({"--in", "{dir}/in.csv", "--svg", "{dir}/sub/../in.csv"}).find("--svg") == 0);
+  CHECK(refused({"--in", "{dir}/link.csv", "--out", "{dir}/in.csv"}).find("is the input of --in") != std::string::npos);
+  CHECK(refused({"--more", "{dir}/x.csv", "--more", "{dir}/in.csv", "--out", "{dir}/in.csv"}).find("--more") !=
+        std::string::npos);
+  CHECK(refused({"--in", "{dir}/sub", "--out", "{dir}/sub/"}).find("is the input of --in") != std::string::npos);
+  // Outputs that do not exist yet are compared as paths.
+  CHECK(refused({"--out", "{dir}/new.csv", "--svg", "{dir}/./new.csv"}) ==
+        "--out " + d + "/new.csv and --svg " + d + "/./new.csv name the same file; one would overwrite the other");
+  // A custom flag with a role: its keywords are not paths.
+  CHECK(refused({"--loops", "{dir}/in.csv", "--out", "{dir}/in.csv"}).find("is the input of --loops") !=
+        std::string::npos);
+  CHECK(refused({"--loops", "auto", "--out", "auto"}).empty());
+  // Distinct files, and devices (which replace no file), are accepted.
+  CHECK(refused({"--in", "{dir}/in.csv", "--out", "{dir}/out.csv", "--svg", "{dir}/out.svg"}).empty());
+  CHECK(refused({"--out", "/dev/null", "--svg", "/dev/null"}).empty());
+  CHECK(refused({"--in", "/dev/null", "--out", "/dev/null"}).empty());
+}
+
+TEST_CASE("apps::Parser: real_in bounds a value and says so in --help", "[examples][cli]") {
+  double rate = 20;
+  apps::Parser cli("prog", "", "");
+  cli.real_in({.name = "--rate", .value = "HZ", .help = "frame rate", .unit = "Hz"}, rate, 0.1, 1000.0);
+  std::ostringstream help;
+  CHECK(cli.help().find("frame rate; 0.1 to 1000 (default 20 Hz)") != std::string::npos);
+  REQUIRE(cli.parse(command({"--rate", "1000"}), help));
+  CHECK(rate == 1000);
+  for (const char* bad : {"2e6", "0.09", "-1", "nan", "inf"}) {
+    INFO(bad);
+    CHECK_THROWS_AS(cli.parse(command({"--rate", bad}), help), apps::usage_error);
+  }
+  try {
+    (void)cli.parse(command({"--rate", "2e6"}), help);
+  } catch (const apps::usage_error& e) {
+    CHECK(std::string(e.what()) == "--rate: expected a number from 0.1 to 1000, got '2e6'");
+  }
+  CHECK(apps::num(104.99993599999999) == "105");
+  CHECK(apps::num(1e-9) == "1e-09");
 }
 
 TEST_CASE("apps::Parser: declaring a flag twice or a bad name is a programming error",

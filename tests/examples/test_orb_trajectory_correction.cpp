@@ -166,7 +166,6 @@ TEST_CASE("orb_trajectory_correction: bad data exits 1 with one line, never prin
       {g + " --estimate '" + (dir.path() / "absent.txt").string() + "'", "absent.txt: cannot open"},
       {g + " --estimate '" + big.string() + "'", "big.txt:2: position coordinate of magnitude 1e+308 m is beyond 1e+100 m"},
       {g + " --estimate '" + short_est.string() + "'", "short.txt has 1 poses but the ground truth has 4"},
-      {"--cv-q 1e308", "the cv filter step was not applied"},  // accepted as a number, fails as data
   };
   for (const auto& c : cases) {
     const auto r = posefuse::test::run(exe, c.args, dir);
@@ -178,11 +177,15 @@ TEST_CASE("orb_trajectory_correction: bad data exits 1 with one line, never prin
     CHECK(r.out.empty());
     CHECK_FALSE(has_non_finite(r.out));
   }
-  // --R 1e308 is a valid (finite, positive) variance: whatever the run gives,
-  // it is a success or a data error, never inf or nan in the table.
-  const auto huge_r = posefuse::test::run(exe, "--R 1e308", dir);
-  CHECK((huge_r.status == 0 || huge_r.status == 1));
-  CHECK_FALSE(has_non_finite(huge_r.out));
+  // Noise no filter step can use (--R 1e308, --cv-q 1e308) is the flag's
+  // fault: a usage error naming it, before any work.
+  for (const char* flag : {"--R", "--cv-q"}) {
+    const auto huge_r = posefuse::test::run(exe, std::string(flag) + " 1e308", dir);
+    INFO(huge_r.err);
+    CHECK(huge_r.status == 2);
+    CHECK(huge_r.err.find(std::string(flag) + ": expected a number from 1e-08 to 1e+08") != std::string::npos);
+    CHECK(huge_r.out.empty());
+  }
 }
 
 TEST_CASE("orb_trajectory_correction: zero error before gives a defined reduction",
@@ -248,8 +251,10 @@ TEST_CASE("orb_trajectory_correction: outputs are written only when the whole ru
     CHECK(posefuse::test::slurp(out) == "previous\n");
   }
   SECTION("a data error writes nothing") {
-    const auto r = posefuse::test::run(exe, "--cv-q 1e308 --out '" + out.string() + "' --plot '" +
-                                                plot.string() + "'", dir);
+    const auto short_est = dir.write("short.txt", "1 0 0 0 0 1 0 0 0 0 1 0\n");
+    const auto r = posefuse::test::run(exe, "--groundtruth '" + gt.string() + "' --estimate '" + short_est.string() +
+                                                "' --out '" + out.string() + "' --plot '" + plot.string() + "'",
+                                       dir);
     CHECK(r.status == 1);
     CHECK_FALSE(std::filesystem::exists(out));
     CHECK_FALSE(std::filesystem::exists(plot));

@@ -16,12 +16,15 @@
 #include <unistd.h>
 #include <vector>
 
+#include "examples/program_probe.hpp"
 #include "support/data_path.hpp"
 #include "support/run_program.hpp"
 #include "support/temp_dir.hpp"
 
 namespace fs = std::filesystem;
+using posefuse::test::check;
 using posefuse::test::count_lines;
+using posefuse::test::Probe;
 using posefuse::test::Run;
 using posefuse::test::TempDir;
 
@@ -59,39 +62,6 @@ RestRecording rest_recording(double seconds, int skip = 0) {
     t += k % 2 == 0 ? 49999872 : 50000128;
   }
   return r;
-}
-
-/// One probe: a program, its arguments (with {dir} for the scratch folder),
-/// the exit status, text the stderr line must contain and text it must not.
-struct Probe {
-  std::string program, args;
-  int status;
-  std::vector<std::string> contains, absent;
-};
-
-std::string expand(std::string args, const TempDir& dir) {
-  const std::string key = "{dir}";
-  for (std::size_t at = args.find(key); at != std::string::npos; at = args.find(key))
-    args.replace(at, key.size(), dir.path().string());
-  return args;
-}
-
-void check(const Probe& p, const TempDir& dir) {
-  const fs::path exe = posefuse::test::example(p.program);
-  if (exe.empty()) {
-    WARN("SKIPPED: example '" << p.program << "' not built");
-    return;
-  }
-  const Run r = posefuse::test::run(exe, expand(p.args, dir), dir);
-  INFO(p.program << " " << p.args << "\nstderr: " << r.err);
-  CHECK(r.status == p.status);
-  if (p.status != 0) {
-    CHECK(count_lines(r.err) == 1);
-    CHECK(r.err.rfind(p.program + ": ", 0) == 0);
-    CHECK((p.status == 2) == (r.err.find("(try --help)") != std::string::npos));
-  }
-  for (const std::string& c : p.contains) CHECK(r.err.find(expand(c, dir)) != std::string::npos);
-  for (const std::string& a : p.absent) CHECK(r.err.find(a) == std::string::npos);
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 // V1_01_easy files when present (skipped visibly otherwise).
 #include <catch2/catch.hpp>
 
+#include <limits>
 #include <string>
 
 #include <posefuse/io/euroc.hpp>
@@ -55,6 +56,42 @@ TEST_CASE("EuRoC: malformed IMU files give file:line errors", "[io][euroc]") {
              Catch::Contains("empty.csv: no IMU samples"));
   CHECK_THAT(io_error_of([&] { (void)posefuse::read_euroc_imu(dir.path() / "missing.csv"); }),
              Catch::Contains("missing.csv"));
+}
+
+TEST_CASE("EuRoC: IMU readings beyond the stated, configurable bounds are refused", "[io][euroc]") {
+  posefuse::test::TempDir dir("euroc");
+  const auto file = [&](const std::string& reading) {
+    return dir.write("imu.csv", std::string(kImuHeader) + "1000,0,0,0,0,0,9.81\n2000," + reading + "\n");
+  };
+  // Defaults: 50 rad/s and 500 m/s^2 per axis (EuRoC's ADIS16448 saturates
+  // at 17.5 rad/s and 176 m/s^2).
+  CHECK(posefuse::kMaxAbsAngularRate == 50.0);
+  CHECK(posefuse::kMaxAbsSpecificForce == 500.0);
+  CHECK_NOTHROW(posefuse::read_euroc_imu(file("-50,0,0,0,0,-500")));
+  CHECK_THAT(io_error_of([&] { (void)posefuse::read_euroc_imu(file("9000,0,0,0,0,9.81")); }),
+             Catch::Contains("imu.csv:3: angular rate of magnitude 9000 rad/s is beyond the physical bound 50 rad/s"));
+  CHECK_THAT(io_error_of([&] { (void)posefuse::read_euroc_imu(file("0,0,0,0,1e308,9.81")); }),
+             Catch::Contains("imu.csv:3: specific force of magnitude 1e+308 m/s^2 is beyond the physical bound 500"));
+  CHECK_THAT(io_error_of([&] { (void)posefuse::read_euroc_imu(file("0,0,50.000001,0,0,9.81")); }),
+             Catch::Contains("imu.csv:3: angular rate of magnitude 50 rad/s is beyond"));
+  // A sensor of a wider range: the bounds are options.
+  posefuse::ImuReadOptions wide;
+  wide.max_abs_angular_rate = 1e4;
+  wide.max_abs_specific_force = 2000;
+  const auto s = posefuse::read_euroc_imu(file("9000,0,0,0,0,1500"), wide);
+  REQUIRE(s.size() == 2);
+  CHECK(s[1].gyro_radps.x() == 9000);
+  CHECK_THAT(io_error_of([&] { (void)posefuse::read_euroc_imu(file("0,0,0,0,0,2001"), wide); }),
+             Catch::Contains("beyond the physical bound 2000 m/s^2"));
+  // Bounds beyond what pre-integration can hold are refused.
+  for (const double bad : {0.0, -1.0, 2e4, std::numeric_limits<double>::quiet_NaN()}) {
+    posefuse::ImuReadOptions o;
+    o.max_abs_angular_rate = bad;
+    CHECK_THROWS_AS(posefuse::read_euroc_imu(file("0,0,0,0,0,9.81"), o), posefuse::invalid_argument);
+  }
+  posefuse::ImuReadOptions o;
+  o.max_abs_specific_force = 1e8;
+  CHECK_THROWS_AS(posefuse::read_euroc_imu(file("0,0,0,0,0,9.81"), o), posefuse::invalid_argument);
 }
 
 TEST_CASE("EuRoC: ground truth with 8 or 17 columns", "[io][euroc]") {

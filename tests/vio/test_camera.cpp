@@ -153,7 +153,7 @@ TEST_CASE("Camera: sensor.yaml errors name file:line or the missing key", "[vio]
   CHECK_THAT(err(std::string(kEurocCam0) + "no colon here\n"), Catch::Contains("c.yaml:22: expected 'key: value'"));
   // A distortion that folds inside the image is refused, naming the file.
   CHECK_THAT(err(with_line("distortion_coefficients", "distortion_coefficients: [-0.9, 0.0, 0, 0]")),
-             Catch::Contains("c.yaml: PinholeRadtan: the distortion cannot be inverted"));
+             Catch::Contains("c.yaml: the camera is not usable: the distortion cannot be inverted"));
 }
 
 TEST_CASE("Camera: projection and undistortion round trip over the image", "[vio][camera]") {

@@ -143,7 +143,7 @@ template <class Lazy = void>
                                     double max_diff_s = 0.01, double offset_est_s = 0.0) {
   if (!(max_diff_s >= 0.0) || !std::isfinite(max_diff_s)) {
     throw invalid_argument("associate: max time difference must be finite and >= 0, got " +
-                           detail::traj_io::format_number(max_diff_s));
+                           detail::message_number(max_diff_s));
   }
   if (!std::isfinite(offset_est_s)) {
     throw invalid_argument("associate: time offset must be finite");
@@ -163,8 +163,8 @@ template <class Lazy = void>
     throw invalid_argument("associate: found no matching timestamps between the reference (" +
                            std::to_string(ref_stamps.size()) + " stamps) and the estimate (" +
                            std::to_string(est_stamps.size()) + " stamps) with max. time diff " +
-                           detail::traj_io::format_number(max_diff_s) + " s and time offset " +
-                           detail::traj_io::format_number(offset_est_s) + " s" +
+                           detail::message_number(max_diff_s) + " s and time offset " +
+                           detail::message_number(offset_est_s) + " s" +
                            detail::traj_io::stamp_unit_hint(ref_stamps, est_stamps));
   }
   return a;

@@ -23,8 +23,9 @@
 /// (spaces around them are allowed). A stamp must be a decimal integer that
 /// fits int64; every other field a finite number. IMU readings and the
 /// ground truth's biases must lie within physical bounds: an angular rate
-/// within kMaxAbsAngularRate (1e4 rad/s) and a specific force within
-/// kMaxAbsSpecificForce (1e7 m/s²) per axis; positions within
+/// within kMaxAbsAngularRate (50 rad/s) and a specific force within
+/// kMaxAbsSpecificForce (500 m/s²) per axis, bounds the IMU reader can
+/// widen (ImuReadOptions) for a sensor of a wider range; positions within
 /// kMaxAbsPosition (1e100 m), as for every trajectory reader. Stamps must increase
 /// strictly: a repeated or earlier stamp is an error naming both lines
 /// (the ground-truth reader can keep the first or last of repeated stamps
@@ -50,6 +51,7 @@
 #include <posefuse/core/time.hpp>
 #include <posefuse/core/trajectory.hpp>
 #include <posefuse/io/detail/line_reader.hpp>
+#include <posefuse/io/detail/message_number.hpp>
 #include <posefuse/io/detail/text.hpp>
 #include <posefuse/io/read_options.hpp>
 
@@ -75,18 +77,30 @@ struct EurocGroundTruth {
   [[nodiscard]] bool has_velocity_and_biases() const noexcept { return velocity.has_value(); }
 };
 
-/// Largest accepted magnitude (rad/s) of an angular rate (a gyroscope
-/// reading or bias axis) in a EuRoC file: about 1 600 revolutions per
-/// second, far beyond the range of any gyroscope (MEMS parts saturate near
-/// 35 rad/s). Larger values are corrupt, and their products in
-/// pre-integration overflow.
-inline constexpr double kMaxAbsAngularRate = 1e4;
+/// Default largest magnitude (rad/s) of an angular rate (a gyroscope
+/// reading or bias axis) in a EuRoC file: about 2 900 deg/s, beyond the
+/// range of the gyroscopes of visual-inertial rigs (MEMS parts saturate at
+/// 2 000 deg/s, 35 rad/s; EuRoC's ADIS16448 at 1 000 deg/s). A reading
+/// beyond it is corrupt or saturated; ImuReadOptions raises it for a sensor
+/// of a wider range.
+inline constexpr double kMaxAbsAngularRate = 50.0;
 
-/// Largest accepted magnitude (m/s²) of a specific force (an accelerometer
-/// reading or bias axis) in a EuRoC file: about 1e6 g, beyond shock
-/// accelerometers (near 1e5 g). Larger values are corrupt, and their
-/// products in pre-integration overflow.
-inline constexpr double kMaxAbsSpecificForce = 1e7;
+/// Default largest magnitude (m/s²) of a specific force (an accelerometer
+/// reading or bias axis) in a EuRoC file: about 51 g, beyond the range of
+/// the accelerometers of visual-inertial rigs (16 g; EuRoC's ADIS16448
+/// 18 g). ImuReadOptions raises it for a sensor of a wider range.
+inline constexpr double kMaxAbsSpecificForce = 500.0;
+
+/// The largest bounds ImuReadOptions accepts: beyond them the products of
+/// pre-integration overflow.
+inline constexpr double kMaxAbsAngularRateLimit = 1e4;
+inline constexpr double kMaxAbsSpecificForceLimit = 1e7;
+
+/// Bounds of the EuRoC IMU reader (read_euroc_imu).
+struct ImuReadOptions {
+  double max_abs_angular_rate = kMaxAbsAngularRate;      ///< per axis (rad/s), in (0, 1e4]
+  double max_abs_specific_force = kMaxAbsSpecificForce;  ///< per axis (m/s²), in (0, 1e7]
+};
 
 namespace detail::euroc_io {
 
@@ -97,19 +111,18 @@ void check_bound(const Eigen::Vector3d& v, double bound, const char* what, const
                  const std::filesystem::path& file, std::size_t line) {
   const double m = v.cwiseAbs().maxCoeff();
   if (m <= bound) return;
-  char buf[160];
-  std::snprintf(buf, sizeof buf, "%s of magnitude %g %s is beyond the physical bound %g %s", what, m,
-                unit, bound, unit);
-  throw io_error(file, line, buf);
+  throw io_error(file, line,
+                 std::string(what) + " of magnitude " + posefuse::detail::message_number(m) + " " + unit +
+                     " is beyond the physical bound " + posefuse::detail::message_number(bound) + " " + unit);
 }
 
-/// Refuses an angular rate beyond kMaxAbsAngularRate and a specific force
-/// beyond kMaxAbsSpecificForce (file:line).
+/// Refuses an angular rate and a specific force beyond `bounds` (file:line).
 template <class Lazy = void>
 void check_imu_bounds(const Eigen::Vector3d& gyro, const Eigen::Vector3d& accel, const char* gyro_what,
-                      const char* accel_what, const std::filesystem::path& file, std::size_t line) {
-  check_bound(gyro, kMaxAbsAngularRate, gyro_what, "rad/s", file, line);
-  check_bound(accel, kMaxAbsSpecificForce, accel_what, "m/s^2", file, line);
+                      const char* accel_what, const std::filesystem::path& file, std::size_t line,
+                      const ImuReadOptions& bounds = {}) {
+  check_bound(gyro, bounds.max_abs_angular_rate, gyro_what, "rad/s", file, line);
+  check_bound(accel, bounds.max_abs_specific_force, accel_what, "m/s^2", file, line);
 }
 
 /// Splits a csv line at commas, trimming spaces and tabs around each field.
@@ -180,12 +193,17 @@ void check_order(std::int64_t t_ns, std::int64_t previous, std::size_t previous_
 /// @return the samples in file order, stamps strictly increasing
 /// @throws posefuse::io_error (file:line) when the file cannot be opened or
 ///         read, a line has not 7 fields, a stamp is not an int64 integer, a
-///         number is unparsable or not finite, an angular rate is beyond
-///         kMaxAbsAngularRate or a specific force beyond
-///         kMaxAbsSpecificForce, a stamp repeats or goes back, a line is
-///         longer than kMaxLineBytes; (file only) when it has no data line
+///         number is unparsable or not finite, an angular rate or a specific
+///         force beyond `options`' bounds, a stamp repeats or goes back, a
+///         line is longer than kMaxLineBytes; (file only) when it has no data line
+/// @throws posefuse::invalid_argument for a bound not in (0, kMaxAbs...Limit]
 template <class Lazy = void>
-[[nodiscard]] std::vector<ImuSample> read_euroc_imu(const std::filesystem::path& file) {
+[[nodiscard]] std::vector<ImuSample> read_euroc_imu(const std::filesystem::path& file,
+                                                    const ImuReadOptions& options = {}) {
+  if (!(options.max_abs_angular_rate > 0 && options.max_abs_angular_rate <= kMaxAbsAngularRateLimit))
+    throw invalid_argument("read_euroc_imu: max_abs_angular_rate must be in (0, 1e4] rad/s");
+  if (!(options.max_abs_specific_force > 0 && options.max_abs_specific_force <= kMaxAbsSpecificForceLimit))
+    throw invalid_argument("read_euroc_imu: max_abs_specific_force must be in (0, 1e7] m/s^2");
   detail::LineReader reader(file);
   std::vector<ImuSample> out;
   std::vector<double> v;
@@ -201,7 +219,7 @@ template <class Lazy = void>
     s.gyro_radps = Eigen::Vector3d(v[0], v[1], v[2]);
     s.accel_mps2 = Eigen::Vector3d(v[3], v[4], v[5]);
     detail::euroc_io::check_imu_bounds(s.gyro_radps, s.accel_mps2, "angular rate", "specific force",
-                                       file, n);
+                                       file, n, options);
     out.push_back(s);
     previous_line = n;
   }

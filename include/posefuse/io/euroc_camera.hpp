@@ -143,9 +143,9 @@ template <class Lazy = void>
     const double dev = std::abs(d[12]) + std::abs(d[13]) + std::abs(d[14]) + std::abs(d[15] - 1.0);
     if (!(dev <= 1e-9))
       throw io_error(file, data->line,
-                     "T_BS last row is not 0 0 0 1 (" + traj_io::format_number(d[12]) + " " +
-                         traj_io::format_number(d[13]) + " " + traj_io::format_number(d[14]) + " " +
-                         traj_io::format_number(d[15]) + ")");
+                     "T_BS last row is not 0 0 0 1 (" + detail::message_number(d[12]) + " " +
+                         detail::message_number(d[13]) + " " + detail::message_number(d[14]) + " " +
+                         detail::message_number(d[15]) + ")");
   }
   Eigen::Matrix3d R;
   R << d[0], d[1], d[2], d[4], d[5], d[6], d[8], d[9], d[10];
@@ -214,7 +214,7 @@ template <class Lazy = void>
                                         "' needs distortion_coefficients: [k1, k2, p1, p2]");
     if (dc.size() == 5 && dc[4] != 0.0)
       throw io_error(file, coeff_line,
-                     "distortion_coefficients: k3 = " + detail::traj_io::format_number(dc[4]) +
+                     "distortion_coefficients: k3 = " + detail::message_number(dc[4]) +
                          " is not supported (4 coefficients k1, k2, p1, p2, or k3 = 0)");
     if (dc.size() != 4 && dc.size() != 5)
       throw io_error(file, coeff_line,

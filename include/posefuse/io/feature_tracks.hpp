@@ -26,10 +26,16 @@
 /// (naming both lines), a non-finite or unparsable number, and — when the
 /// image size is given — a pixel outside the image
 /// \f$ [-0.5, w - 0.5] \times [-0.5, h - 0.5] \f$. A file without rows is an
-/// error too.
+/// error too. Sub-pixel trackers and undistort/redistort round trips give
+/// pixels a little outside the image: with FeatureTrackReadOptions::
+/// drop_margin_px > 0, a pixel outside the image by at most that margin is
+/// dropped (counted by read_feature_tracks_counted) instead of refused; one
+/// farther out is still refused (a wrong image size, a wrong file).
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -41,6 +47,7 @@
 
 #include <posefuse/core/error.hpp>
 #include <posefuse/io/detail/line_reader.hpp>
+#include <posefuse/io/detail/message_number.hpp>
 #include <posefuse/io/detail/text.hpp>
 #include <posefuse/io/euroc.hpp>
 
@@ -66,6 +73,17 @@ struct FeatureTrackReadOptions {
   /// Image size (px); pixels outside the image are refused when both are > 0.
   int image_width = 0;
   int image_height = 0;  ///< see image_width
+  /// Pixels outside the image by at most this much (px, per axis) are
+  /// dropped rather than refused; 0: every pixel outside is refused.
+  double drop_margin_px = 0.0;
+};
+
+/// Feature tracks and the observations the reader dropped.
+struct FeatureTrackRead {
+  FeatureTracks tracks;           ///< the frames (see read_feature_tracks)
+  std::size_t dropped = 0;        ///< observations outside the image within the margin
+  std::size_t first_dropped_line = 0;  ///< line of the first of them (0: none)
+  double worst_outside_px = 0.0;  ///< how far outside the image the farthest was (px)
 };
 
 /// The header line the writer writes and the reader accepts.
@@ -93,14 +111,19 @@ template <class Lazy = void>
 /// @param[in] file the csv
 /// @param[in] options the image size to check pixels against (optional)
 /// @return the frames in file order, stamps strictly increasing, each with
-///         its features in file order
+///         its features in file order (less the dropped ones), and the
+///         count of observations dropped within options.drop_margin_px
 /// @throws posefuse::io_error (file:line) for every violation listed in the
 ///         file comment; (file) when it cannot be read or has no rows
+/// @throws posefuse::invalid_argument for a negative or non-finite margin
 template <class Lazy = void>
-[[nodiscard]] FeatureTracks read_feature_tracks(const std::filesystem::path& file,
-                                                const FeatureTrackReadOptions& options = {}) {
+[[nodiscard]] FeatureTrackRead read_feature_tracks_counted(const std::filesystem::path& file,
+                                                           const FeatureTrackReadOptions& options = {}) {
+  if (!(options.drop_margin_px >= 0.0 && std::isfinite(options.drop_margin_px)))
+    throw invalid_argument("read_feature_tracks: drop_margin_px must be finite and >= 0");
   detail::LineReader reader(file);
-  FeatureTracks out;
+  FeatureTrackRead result;
+  FeatureTracks& out = result.tracks;
   std::unordered_map<std::uint64_t, std::size_t> frame_ids;  // id -> line, current frame
   const bool check_image = options.image_width > 0 && options.image_height > 0;
   const double u_max = options.image_width - 0.5, v_max = options.image_height - 0.5;
@@ -125,14 +148,24 @@ template <class Lazy = void>
     o.id = detail::tracks_io::parse_id(f[1], file, n);
     o.uv = Eigen::Vector2d(detail::traj_io::parse_number(f[2], file, n, 3),
                            detail::traj_io::parse_number(f[3], file, n, 4));
-    if (check_image && !(o.uv.x() >= -0.5 && o.uv.x() <= u_max && o.uv.y() >= -0.5 && o.uv.y() <= v_max))
-      throw io_error(file, n,
-                     "pixel (" + detail::traj_io::format_number(o.uv.x()) + ", " +
-                         detail::traj_io::format_number(o.uv.y()) + ") is outside the " +
-                         std::to_string(options.image_width) + "x" +
-                         std::to_string(options.image_height) + " image ([-0.5, " +
-                         detail::traj_io::format_number(u_max) + "] x [-0.5, " +
-                         detail::traj_io::format_number(v_max) + "])");
+    bool drop = false;
+    if (check_image && !(o.uv.x() >= -0.5 && o.uv.x() <= u_max && o.uv.y() >= -0.5 && o.uv.y() <= v_max)) {
+      const double outside = std::max({-0.5 - o.uv.x(), o.uv.x() - u_max, -0.5 - o.uv.y(), o.uv.y() - v_max});
+      if (!(outside <= options.drop_margin_px))
+        throw io_error(file, n,
+                       "pixel (" + detail::message_number(o.uv.x()) + ", " + detail::message_number(o.uv.y()) +
+                           ") is outside the " + std::to_string(options.image_width) + "x" +
+                           std::to_string(options.image_height) + " image ([-0.5, " +
+                           detail::message_number(u_max) + "] x [-0.5, " + detail::message_number(v_max) + "]" +
+                           (options.drop_margin_px > 0
+                                ? " by " + detail::message_number(outside) + " px, more than the " +
+                                      detail::message_number(options.drop_margin_px) + " px margin"
+                                : std::string()) +
+                           ")");
+      drop = true;
+      if (result.dropped++ == 0) result.first_dropped_line = n;
+      result.worst_outside_px = std::max(result.worst_outside_px, outside);
+    }
     if (out.empty() || t > out.back().t_ns) {
       out.push_back(TrackFrame{t, {}});
       frame_ids.clear();
@@ -145,11 +178,20 @@ template <class Lazy = void>
       throw io_error(file, n,
                      "feature id " + std::to_string(o.id) + " repeats within the image at " +
                          std::to_string(t) + " ns (line " + std::to_string(it->second) + ")");
-    out.back().features.push_back(o);
+    if (!drop) out.back().features.push_back(o);
     previous_line = n;
   }
   if (out.empty()) throw io_error(file, "no feature observations (the file has no data rows)");
-  return out;
+  return result;
+}
+
+/// Reads a feature-track csv (see the file comment); read_feature_tracks_counted
+/// without the count of dropped observations.
+/// @throws posefuse::io_error as read_feature_tracks_counted
+template <class Lazy = void>
+[[nodiscard]] FeatureTracks read_feature_tracks(const std::filesystem::path& file,
+                                                const FeatureTrackReadOptions& options = {}) {
+  return read_feature_tracks_counted(file, options).tracks;
 }
 
 /// Writes feature tracks as csv with the header line (see the file comment);

@@ -77,7 +77,7 @@ template <class Lazy = void>
   if (n == 0.0) throw io_error(file, line, "the quaternion is zero");
   if (!(std::abs(n - 1.0) <= 1e-3))
     throw io_error(file, line,
-                   "the quaternion is not unit (norm " + traj_io::format_number(n) + ", expected 1 within 1e-3)");
+                   "the quaternion is not unit (norm " + detail::message_number(n) + ", expected 1 within 1e-3)");
   return q.normalized();
 }
 

@@ -60,13 +60,15 @@ template <class Lazy = void>
 /// @return the samples
 /// @throws posefuse::io_error (file:line) as read_euroc_imu, and for a gap:
 ///         `file:N: gap of X ms after line M (limit Y ms)`
-/// @throws posefuse::invalid_argument for a non-positive limit
+/// @param[in] options the reader's bounds on the readings
+/// @throws posefuse::invalid_argument for a non-positive limit or bad bounds
 template <class Lazy = void>
 [[nodiscard]] std::vector<ImuSample> read_euroc_imu_checked(const std::filesystem::path& file,
-                                                            std::int64_t max_interval_ns) {
+                                                            std::int64_t max_interval_ns,
+                                                            const ImuReadOptions& options = {}) {
   if (max_interval_ns <= 0)
     throw invalid_argument("read_euroc_imu_checked: the gap limit must be > 0 ns");
-  std::vector<ImuSample> samples = read_euroc_imu(file);  // every check of the reader
+  std::vector<ImuSample> samples = read_euroc_imu(file, options);  // every check of the reader
   const std::vector<ImuGap> gaps = find_imu_gaps(samples, max_interval_ns);
   if (gaps.empty()) return samples;
   // Only on failure: a second pass finds the lines of the samples around the
@@ -81,7 +83,7 @@ template <class Lazy = void>
     if (data_lines == after) line_after = reader.line_no();
     ++data_lines;
   }
-  const auto ms = [](std::int64_t ns) { return detail::traj_io::format_number(double(ns) * 1e-6); };
+  const auto ms = [](std::int64_t ns) { return detail::message_number(double(ns) * 1e-6); };
   throw io_error(file, line_after,
                  "gap of " + ms(gaps.front().length_ns()) + " ms after line " + std::to_string(line_before) +
                      " (the limit is " + ms(max_interval_ns) + " ms)");

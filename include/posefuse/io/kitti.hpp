@@ -160,10 +160,12 @@ template <class Lazy = void>
   // file goes with data line k of the pose file.
   const std::size_t n_stamps = all_lines.size();
   if (n_stamps > n_poses) {
-    throw io_error(*times_file, all_lines[n_poses],
-                   "times file has " + std::to_string(n_stamps) + " timestamps but " +
-                       poses_file.string() + " has " + std::to_string(n_poses) +
-                       " poses; this is the first timestamp without a pose");
+    // The pose file is the short one (a times file is often shared by the
+    // ground truth, the estimate and a control): it is named.
+    throw io_error(poses_file, "pose file has " + std::to_string(n_poses) + " poses but " + times_file->string() +
+                                   " has " + std::to_string(n_stamps) + " timestamps (line " +
+                                   std::to_string(all_lines[n_poses]) +
+                                   " of the times file is the first without a pose): is the pose file cut short?");
   }
   if (n_stamps < n_poses) {
     throw io_error(poses_file, rows.lines[n_stamps],

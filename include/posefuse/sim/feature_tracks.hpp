@@ -64,6 +64,7 @@
 #include <posefuse/core/error.hpp>
 #include <posefuse/core/interpolation.hpp>
 #include <posefuse/core/time.hpp>
+#include <posefuse/io/detail/message_number.hpp>
 #include <posefuse/io/euroc.hpp>
 #include <posefuse/sim/detail/feature_track_scene.hpp>
 #include <posefuse/sim/imu.hpp>
@@ -143,6 +144,41 @@ struct SimulatedTracks {
   std::size_t frames_below_target = 0;        ///< frames with fewer than features_per_frame features
 };
 
+/// Most landmarks and most observations one simulation may hold (about
+/// 0.5 GB each); a larger scene or output is refused before anything is
+/// allocated (track_simulation_size).
+inline constexpr double kMaxSimulatedLandmarks = 1e7;
+inline constexpr double kMaxSimulatedObservations = 1e7;
+
+/// How large a simulation would be, estimated before it allocates anything.
+struct TrackSimSize {
+  double frames = 0;            ///< frame stamps
+  double wall_landmarks = 0;    ///< landmarks on the six faces of the room
+  double landmarks = 0;         ///< walls and free points
+  double max_observations = 0;  ///< frames x features_per_frame (an upper bound)
+  /// True when both counts are within kMaxSimulatedLandmarks and
+  /// kMaxSimulatedObservations.
+  [[nodiscard]] bool fits() const noexcept {
+    return landmarks <= kMaxSimulatedLandmarks && max_observations <= kMaxSimulatedObservations;
+  }
+};
+
+/// The size of a simulation of `frames` frames whose camera positions span
+/// the box [path_lo, path_hi] (world axes), as simulate_feature_tracks
+/// builds it (room = the box grown by room_margin_m).
+[[nodiscard]] inline TrackSimSize track_simulation_size(double frames, const Eigen::Vector3d& path_lo,
+                                                        const Eigen::Vector3d& path_hi,
+                                                        const TrackSimConfig& config) {
+  TrackSimSize s;
+  s.frames = frames;
+  const Eigen::Vector3d size = (path_hi - path_lo).array() + 2.0 * config.room_margin_m;
+  for (int axis = 0; axis < 3; ++axis)
+    s.wall_landmarks += 2.0 * size((axis + 1) % 3) * size((axis + 2) % 3) * config.wall_density_per_m2;
+  s.landmarks = s.wall_landmarks + double(std::max(config.free_points, 0));
+  s.max_observations = frames * double(std::max(config.features_per_frame, 0));
+  return s;
+}
+
 /// Frame stamps t_first + k * round(1e9 / rate) ns, up to t_last.
 /// @throws posefuse::invalid_argument for a bad rate or t_last < t_first
 [[nodiscard]] inline std::vector<std::int64_t> frame_stamps(std::int64_t t_first_ns, std::int64_t t_last_ns,
@@ -175,11 +211,20 @@ struct SimulatedTracks {
 
   detail::SeededRng rng(config.seed);
   SimulatedTracks out;
-  out.T_W_B = T_W_B;
   std::vector<Eigen::Isometry3d> T_W_C;
   T_W_C.reserve(T_W_B.size());
   for (const Eigen::Isometry3d& T : T_W_B) T_W_C.push_back(T * camera.T_BS);
   const detail::Room room = detail::room_around(T_W_C, config.room_margin_m);
+  {
+    const TrackSimSize size = track_simulation_size(double(t_ns.size()), room.lo.array() + config.room_margin_m,
+                                                    room.hi.array() - config.room_margin_m, config);
+    if (!size.fits())
+      throw invalid_argument("the simulation would hold about " + posefuse::detail::message_number(size.landmarks) +
+                             " landmarks and up to " + posefuse::detail::message_number(size.max_observations) +
+                             " observations (limits " + posefuse::detail::message_number(kMaxSimulatedLandmarks) + " and " +
+                             posefuse::detail::message_number(kMaxSimulatedObservations) + ")");
+  }
+  out.T_W_B = T_W_B;
   detail::add_wall_landmarks(room, config.wall_density_per_m2, rng, out.landmarks_w);
   out.wall_landmarks = out.landmarks_w.size();
   detail::add_free_landmarks(T_W_C, camera, room, std::size_t(config.free_points), config.free_depth_min_m,
@@ -339,9 +384,9 @@ struct SimulatedTracks {
     }
     const std::int64_t ta = gt.t_ns[j], tb = gt.t_ns[j + 1];
     if (tb - ta > max_gap_ns)
-      throw invalid_argument("the ground truth has a gap of " + std::to_string(double(tb - ta) * 1e-9) +
+      throw invalid_argument("the ground truth has a gap of " + posefuse::detail::message_number(double(tb - ta) * 1e-9) +
                              " s between " + std::to_string(ta) + " and " + std::to_string(tb) +
-                             " ns, longer than the " + std::to_string(config.max_pose_gap_s) +
+                             " ns, longer than the " + posefuse::detail::message_number(config.max_pose_gap_s) +
                              " s a frame may be interpolated across");
     const double f = double(tk - ta) / double(tb - ta);
     poses.push_back(interpolate_pose(gt.trajectory.poses[j], gt.trajectory.poses[j + 1], f));

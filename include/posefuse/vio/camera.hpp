@@ -35,11 +35,18 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include <posefuse/core/error.hpp>
+#include <posefuse/io/detail/message_number.hpp>
 #include <posefuse/io/euroc_camera.hpp>
 
 namespace posefuse {
+
+/// Largest focal length (px) a camera may have: a 1000-pixel image then
+/// spans about 0.6 degrees, and beyond it the distortion's inversion cannot
+/// reach pixel accuracy.
+inline constexpr double kMaxFocalPx = 1e5;
 
 /// A pinhole camera with radial-tangential distortion (see the file comment).
 struct PinholeRadtan {
@@ -81,6 +88,12 @@ struct PinholeRadtan {
                         T_BS.matrix().allFinite();
     if (!finite) throw invalid_argument("PinholeRadtan: a parameter is not finite");
     if (!(fu > 0 && fv > 0)) throw invalid_argument("PinholeRadtan: focal lengths must be > 0");
+    // Below 1 px the image would span nearly 180 degrees (a pinhole cannot
+    // see 180); above kMaxFocalPx see its comment.
+    if (!(fu >= 1.0 && fv >= 1.0 && fu <= kMaxFocalPx && fv <= kMaxFocalPx))
+      throw invalid_argument("PinholeRadtan: focal lengths (" + detail::message_number(fu) + ", " +
+                             detail::message_number(fv) + " px) must be from 1 to " +
+                             detail::message_number(kMaxFocalPx) + " px");
     if (width <= 0 || height <= 0) throw invalid_argument("PinholeRadtan: resolution must be positive");
     if (rate_hz < 0) throw invalid_argument("PinholeRadtan: rate_hz must be >= 0");
     // Newton must converge, the result lie inside the unfolded region, and
@@ -93,8 +106,8 @@ struct PinholeRadtan {
         if (!xy.allFinite() || !(xy.squaredNorm() < r2max) ||
             (pixel_of_normalised(xy) - uv).norm() > 1e-6)
           throw invalid_argument(
-              "PinholeRadtan: the distortion cannot be inverted at pixel (" + std::to_string(uv.x()) +
-              ", " + std::to_string(uv.y()) + "): it folds inside the image");
+              "PinholeRadtan: the distortion cannot be inverted at pixel (" + detail::message_number(uv.x()) +
+              ", " + detail::message_number(uv.y()) + "): it folds inside the image");
       }
     }
   }
@@ -200,7 +213,11 @@ template <class Lazy = void>
   try {
     return PinholeRadtan::from_calibration(c);
   } catch (const invalid_argument& e) {
-    throw io_error(file, e.what());
+    // The file, not the class that checked it, is at fault.
+    std::string why = e.what();
+    const std::string_view prefix = "PinholeRadtan: ";
+    if (why.rfind(prefix, 0) == 0) why.erase(0, prefix.size());
+    throw io_error(file, "the camera is not usable: " + why);
   }
 }
 

@@ -24,6 +24,7 @@
 #include <posefuse/core/error.hpp>
 #include <posefuse/io/detail/line_reader.hpp>
 #include <posefuse/io/read_options.hpp>
+#include <posefuse/io/detail/message_number.hpp>
 
 /// Internals of the trajectory readers/writers; nested so that other io
 /// headers (e.g. robot_log.hpp) can keep their own detail helpers.
@@ -236,12 +237,12 @@ template <class Lazy = void>
   const double residual = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   if (!(residual <= tolerance)) {
     throw io_error(file, line,
-                   "rotation is not orthonormal: max |R^T R - I| = " + format_number(residual) +
-                       " exceeds the tolerance " + format_number(tolerance));
+                   "rotation is not orthonormal: max |R^T R - I| = " + message_number(residual) +
+                       " exceeds the tolerance " + message_number(tolerance));
   }
   const double det = R.determinant();
   if (!(det > 0.0)) {
-    throw io_error(file, line, "rotation is a reflection (det R = " + format_number(det) + ")");
+    throw io_error(file, line, "rotation is a reflection (det R = " + message_number(det) + ")");
   }
   if (residual <= kExactlyOrthonormal) return R;
   Eigen::Matrix3d X = R;
@@ -267,8 +268,8 @@ template <class Lazy = void>
   if (norm == 0.0) throw io_error(file, line, "quaternion has zero norm");
   if (!(std::abs(norm - 1.0) <= tolerance)) {
     throw io_error(file, line,
-                   "quaternion norm " + format_number(norm) + " differs from 1 by more than " +
-                       format_number(tolerance));
+                   "quaternion norm " + message_number(norm) + " differs from 1 by more than " +
+                       message_number(tolerance));
   }
   return q.normalized();
 }
