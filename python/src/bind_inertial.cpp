@@ -151,7 +151,7 @@ ImuState make_state(const py::object& p, const py::object& R, const py::object& 
 
 py::object align_n(int n, const Stack& T, const SE3d& T_b_c, const std::vector<Preintegration>& pre_in,
                    const VisualInertialAlignmentOptions& opt) {
-  std::vector<SE3d> poses(std::size_t(n));
+  std::vector<SE3d> poses(static_cast<std::size_t>(n));
   for (int k = 0; k < n; ++k) poses[std::size_t(k)] = se3_from_matrix(read<4, 4>(T.item(k)));
   std::vector<Preintegration> pre = pre_in;  // re-integrated copies; the caller's objects stay as they were
   const VisualInertialAlignmentResult r =
