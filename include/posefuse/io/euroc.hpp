@@ -190,6 +190,8 @@ void check_order(std::int64_t t_ns, std::int64_t previous, std::size_t previous_
 /// Reads a EuRoC IMU csv (see the file comment). The magnetometer field of
 /// each ImuSample is zero.
 /// @param[in] file path of `imu0/data.csv` (or any file of that layout)
+/// @param[in] options the largest angular rate and specific force accepted
+///                    (physically impossible readings are refused at their line)
 /// @return the samples in file order, stamps strictly increasing
 /// @throws posefuse::io_error (file:line) when the file cannot be opened or
 ///         read, a line has not 7 fields, a stamp is not an int64 integer, a
