@@ -366,8 +366,9 @@ def test_so3_and_se3_exp_of_huge_finite_rotation_vectors_are_rotations(k):
     T, JT = pf.SE3.exp(np.concatenate([rho, phi]), jacobian=True)
     assert np.isfinite(T).all() and np.isfinite(JT).all()
     np.testing.assert_array_equal(T[:3, :3], R)
-    # t = J_l(phi) rho = u u^T rho + O(1/|phi|): the part of rho along the axis.
-    np.testing.assert_allclose(T[:3, 3], u * (u @ rho), rtol=0, atol=1e-14)
+    # t = J_l(phi) rho = u u^T rho + (sin th / th)(rho - u u^T rho) + ((1 - cos th) / th) u x rho:
+    # the part of rho along the axis, within 3 |rho| / th.
+    np.testing.assert_allclose(T[:3, 3], u * (u @ rho), rtol=0, atol=3 * np.linalg.norm(rho) / th + 1e-14)
 
 
 def test_exp_of_a_rotation_vector_of_norm_1e300_is_a_rotation():

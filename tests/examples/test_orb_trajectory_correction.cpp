@@ -78,7 +78,7 @@ TEST_CASE("orb_trajectory_correction: built-in drive reproduces the seed-000 ide
   CHECK(table.out.find("returns its input") != std::string::npos);
 }
 
-TEST_CASE("orb_trajectory_correction: docs/reproductions.md's table and the example's comment are its output",
+TEST_CASE("orb_trajectory_correction: docs/reproductions-seed000.md's table and the example's comment are its output",
           "[examples][seed000]") {
   POSEFUSE_REQUIRE_EXAMPLE(exe, "orb_trajectory_correction");
   posefuse::test::TempDir dir("orb");
@@ -92,7 +92,7 @@ TEST_CASE("orb_trajectory_correction: docs/reproductions.md's table and the exam
   REQUIRE(rows.size() == 5);
   const std::filesystem::path root =
       std::filesystem::path(__FILE__).parent_path().parent_path().parent_path();
-  const std::string page = posefuse::test::slurp(root / "docs" / "reproductions.md");
+  const std::string page = posefuse::test::slurp(root / "docs" / "reproductions-seed000.md");
   const std::string example = posefuse::test::slurp(root / "examples" / "orb_trajectory_correction.cpp");
   for (const std::string& row : rows) {
     INFO(row);

@@ -247,7 +247,7 @@ TEST_CASE("seed000 study: control association errors name the file", "[examples]
     std::string expect;
   };
   for (const Case& c : {Case{one, "one.tum: only 1 frame(s) associate with"},
-                        Case{none, "none.tum: associate: found no matching timestamps"},
+                        Case{none, "none.tum: only 0 frame(s) associate with"},
                         Case{bad, "bad.tum:2:"}}) {
     const auto r = posefuse::test::run(exe, base + "'" + c.control.string() + "'", dir);
     INFO(r.err);

@@ -160,7 +160,7 @@ TEST_CASE("corridor_fusion: a failing --svg leaves no --write-log behind",
     CHECK(f.path().filename().string().find(".tmp.") == std::string::npos);
 }
 
-TEST_CASE("corridor_fusion: docs/reproductions.md's seed-001 table and the example's comment are its output",
+TEST_CASE("corridor_fusion: docs/reproductions-seed001.md's table and the example's comment are its output",
           "[fusion][examples][corridor]") {
   POSEFUSE_REQUIRE_EXAMPLE(exe, "corridor_fusion");
   posefuse::test::TempDir dir("corridor-example");
@@ -169,8 +169,8 @@ TEST_CASE("corridor_fusion: docs/reproductions.md's seed-001 table and the examp
   const auto printed = table_block(r.out);
   REQUIRE(printed.size() == 12);
   const std::filesystem::path root = std::filesystem::path(__FILE__).parent_path().parent_path().parent_path();
-  const std::string page = posefuse::test::slurp(root / "docs" / "reproductions.md");
-  const std::size_t sec = page.find("## Seed 001");
+  const std::string page = posefuse::test::slurp(root / "docs" / "reproductions-seed001.md");
+  const std::size_t sec = page.find("# Seed 001");
   REQUIRE(sec != std::string::npos);
   CHECK(table_block(page.substr(sec)) == printed);
   const std::string example = posefuse::test::slurp(root / "examples" / "corridor_fusion.cpp");
