@@ -48,7 +48,7 @@ std::string still_tracks(double seconds, const std::string& u0 = "30") {
 /// A ground truth (EuRoC, 8 columns) at 20 Hz: `rows` poses from `t0`.
 std::string groundtruth(std::int64_t t0, int rows) {
   std::string s;
-  for (int k = 0; k < rows; ++k) s += std::to_string(t0 + k * 50000000) + ",1,2,3,1,0,0,0\n";
+  for (std::int64_t k = 0; k < rows; ++k) s += std::to_string(t0 + k * 50000000) + ",1,2,3,1,0,0,0\n";
   return s;
 }
 
