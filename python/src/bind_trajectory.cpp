@@ -78,7 +78,9 @@ TrajectoryObject from_arrays(const py::object& stamps_obj, const py::object& pos
           throw py::value_error(row + " = (" + apps::shortest(qk.w()) + ", " + apps::shortest(qk.x()) + ", " +
                                 apps::shortest(qk.y()) + ", " + apps::shortest(qk.z()) +
                                 ") (w, x, y, z) is not finite");
-        const double norm = qk.coeffs().stableNorm();  // no underflow at 1e-300, no overflow at 1e300
+        // The norm scaled by the largest coefficient: exact for (1e-300, 0, 0, 0), finite at 1e300.
+        const double largest = qk.coeffs().cwiseAbs().maxCoeff();
+        const double norm = largest == 0.0 ? 0.0 : largest * (qk.coeffs() / largest).norm();
         if (norm == 0.0) throw py::value_error(row + " is zero: a zero quaternion is no rotation");
         if (!(std::abs(norm - 1.0) <= kQuaternionTolerance))
           throw py::value_error(row + " has norm " + apps::shortest(norm) + ", not 1 (within 1e-3)");
