@@ -105,11 +105,12 @@ struct VisualInertialAlignmentOptions {
   int refinement_iterations = 4;        ///< gravity refinement iterations
 };
 
-/// The result of aligning a run-time number of keyframes (valid only when
-/// status is kOk; diagnostics are filled as far as the computation went).
-/// Not to be confused with posefuse::AlignmentResult (eval/alignment.hpp),
-/// the similarity that aligns an estimated trajectory to a reference.
-struct VisualInertialAlignmentResult {
+/// What a visual-inertial alignment finds besides its per-keyframe arrays
+/// (valid only when status is kOk; diagnostics are filled as far as the
+/// computation went). Not to be confused with posefuse::AlignmentResult
+/// (eval/alignment.hpp), the similarity that aligns an estimated trajectory
+/// to a reference.
+struct VisualInertialAlignmentSummary {
   /// outcome
   VisualInertialAlignmentStatus status = VisualInertialAlignmentStatus::kSolveFailed;
   double scale = 0;                    ///< s: metric = s × SfM units
@@ -117,8 +118,12 @@ struct VisualInertialAlignmentResult {
   double gravity_norm_unrefined = 0;   ///< |g| of step 2 (m/s²)
   double accel_std = 0;                ///< the excitation measure (m/s²)
   Eigen::Vector3d gyro_bias = Eigen::Vector3d::Zero();   ///< estimated b_g (rad/s)
-  std::vector<Eigen::Vector3d> velocity_c0;              ///< v_k in c0 (m/s), one per keyframe when kOk
   SO3d R_w_c0;                         ///< world (z up) from c0
+};
+
+/// The result of aligning a run-time number of keyframes.
+struct VisualInertialAlignmentResult : VisualInertialAlignmentSummary {
+  std::vector<Eigen::Vector3d> velocity_c0;              ///< v_k in c0 (m/s), one per keyframe when kOk
   std::vector<SE3d> T_w_b;             ///< body poses in the world frame (metric), one per keyframe when kOk
   std::vector<Eigen::Vector3d> velocity_w;               ///< v_k in the world frame (m/s), one per keyframe when kOk
 };
@@ -126,16 +131,8 @@ struct VisualInertialAlignmentResult {
 /// The result of aligning N keyframes: VisualInertialAlignmentResult with
 /// fixed-size arrays.
 template <int N>
-struct VisualInertialAlignment {
-  /// outcome
-  VisualInertialAlignmentStatus status = VisualInertialAlignmentStatus::kSolveFailed;
-  double scale = 0;                    ///< s: metric = s × SfM units
-  Eigen::Vector3d gravity_c0 = Eigen::Vector3d::Zero();  ///< g in c0, refined (m/s²)
-  double gravity_norm_unrefined = 0;   ///< |g| of step 2 (m/s²)
-  double accel_std = 0;                ///< the excitation measure (m/s²)
-  Eigen::Vector3d gyro_bias = Eigen::Vector3d::Zero();   ///< estimated b_g (rad/s)
+struct VisualInertialAlignment : VisualInertialAlignmentSummary {
   std::array<Eigen::Vector3d, N> velocity_c0{};          ///< v_k in c0 (m/s)
-  SO3d R_w_c0;                         ///< world (z up) from c0
   std::array<SE3d, N> T_w_b{};         ///< body poses in the world frame (metric)
   std::array<Eigen::Vector3d, N> velocity_w{};           ///< v_k in the world frame (m/s)
 };
@@ -330,13 +327,7 @@ template <int N>
   const VisualInertialAlignmentResult r =
       align_visual_inertial(std::span<const SE3d>(T_c0_c), T_b_c, std::span<Preintegration>(pre), options);
   VisualInertialAlignment<N> out;
-  out.status = r.status;
-  out.scale = r.scale;
-  out.gravity_c0 = r.gravity_c0;
-  out.gravity_norm_unrefined = r.gravity_norm_unrefined;
-  out.accel_std = r.accel_std;
-  out.gyro_bias = r.gyro_bias;
-  out.R_w_c0 = r.R_w_c0;
+  static_cast<VisualInertialAlignmentSummary&>(out) = r;
   for (std::size_t k = 0; k < r.velocity_c0.size() && k < std::size_t(N); ++k) out.velocity_c0[k] = r.velocity_c0[k];
   for (std::size_t k = 0; k < r.T_w_b.size() && k < std::size_t(N); ++k) {
     out.T_w_b[k] = r.T_w_b[k];
