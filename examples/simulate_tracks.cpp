@@ -8,6 +8,11 @@
 //   simulate_tracks --groundtruth V1_01_easy/groundtruth_20hz.csv
 //                   --camera V1_01_easy/cam0_sensor.yaml --out cam0_tracks.csv
 //
+// With --imu-out the program also writes an IMU synthesised from that motion
+// (sim::imu_from_trajectory: a spline through the ground-truth poses, its
+// readings plus seeded noise of --imu-noise densities, starting from the
+// ground truth's first bias), which agrees with the tracks up to that noise.
+//
 // Without --groundtruth the camera flies the built-in synthetic flight
 // (sim::synthetic_flight, --duration seconds) and --groundtruth-out /
 // --imu-out write its ground truth and a simulated IMU (EuRoC csv layouts),
@@ -24,6 +29,7 @@
 #include <iostream>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <apps/cli.hpp>
@@ -35,6 +41,7 @@
 #include <posefuse/io/feature_tracks.hpp>
 #include <posefuse/sim/feature_tracks.hpp>
 #include <posefuse/sim/imu.hpp>
+#include <posefuse/sim/imu_from_trajectory.hpp>
 #include <posefuse/vio/camera.hpp>
 
 namespace {
@@ -46,8 +53,15 @@ struct Options {
   std::optional<std::filesystem::path> groundtruth, camera, out, groundtruth_out, imu_out;
   sim::TrackSimConfig config;
   double duration_s = 60.0;
+  posefuse::ImuNoise imu_noise;  // EuRoC's ADIS16448 datasheet
+  double imu_rate_hz = 200.0;
+  double imu_knot_spacing_s = 0.0;
+  double imu_smoothing = 0.0;
   bool json = false;
 };
+
+// The largest IMU one run may write (samples): about 5 GB of csv.
+constexpr double kMaxImuSamples = 5e7;
 
 std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   Options o;
@@ -96,15 +110,52 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
             .help = "synthetic flight only: write its ground truth (EuRoC csv,\n17 columns, 200 Hz)"},
            o.groundtruth_out);
   cli.output({.name = "--imu-out", .value = "FILE",
-            .help = "synthetic flight only: write a simulated IMU (EuRoC imu0 csv,\n200 Hz, EuRoC ADIS16448 noise, seeded with --seed)"},
+            .help = "write an IMU (EuRoC imu0 csv, seeded with --seed): with --groundtruth\n"
+                    "synthesised from its poses (a spline through them, starting from the\n"
+                    "first row's biases when it has 17 columns); else simulated on the\n"
+                    "synthetic flight"},
            o.imu_out);
+  cli.custom({.name = "--imu-noise", .value = "NA,NG,WA,WG",
+              .help = "with --imu-out: accelerometer and gyroscope noise densities, then\n"
+                      "their random walks (m/s^2/sqrt(Hz), rad/s/sqrt(Hz), m/s^3/sqrt(Hz),\n"
+                      "rad/s^2/sqrt(Hz)); 0,0,0,0 for a noise-free IMU",
+              .default_text = "2e-3,1.6968e-4,3e-3,1.9393e-5 (EuRoC's ADIS16448)"},
+             [&](std::string_view v) {
+               double x[4];
+               std::size_t start = 0;
+               for (int i = 0; i < 4; ++i) {
+                 const std::size_t comma = i < 3 ? v.find(',', start) : v.size();
+                 if (comma == std::string_view::npos || (i == 3 && v.find(',', start) != std::string_view::npos))
+                   throw apps::usage_error("expected four comma-separated numbers, got '" + std::string(v) + "'");
+                 x[i] = apps::parse_real(v.substr(start, comma - start), apps::Domain::kNonNegative);
+                 if (!(x[i] <= 100.0))
+                   throw apps::usage_error("each value must be from 0 to 100, got '" + std::string(v) + "'");
+                 start = comma + 1;
+               }
+               o.imu_noise = posefuse::ImuNoise{x[1], x[0], x[3], x[2]};
+             });
+  cli.real_in({.name = "--imu-rate", .value = "HZ", .help = "with --imu-out: IMU sample rate", .unit = "Hz"},
+              o.imu_rate_hz, 1.0, 10000.0);
+  cli.real_in({.name = "--imu-knot-spacing", .value = "S",
+               .help = "with --groundtruth --imu-out: knot spacing of the spline\n(0: the ground truth's mean spacing, "
+                       "a fit through the poses;\nlarger smooths)",
+               .unit = "s"},
+              o.imu_knot_spacing_s, 0.0, 60.0);
+  cli.real_in({.name = "--imu-smoothing", .value = "L",
+               .help = "with --groundtruth --imu-out: weight of the spline's second\ndifferences (0: a fit through the "
+                       "poses; larger smooths)"},
+              o.imu_smoothing, 0.0, 1e12);
   cli.flag({.name = "--json", .help = "print one JSON object instead of the summary"}, o.json);
   cli.epilogue("Exit status: 0 ok, 1 bad data (file:line where a file is at fault), 2 bad usage.");
   if (!cli.parse(cmd)) return std::nullopt;
   if (!o.out) throw apps::usage_error("--out is required");
   if (o.groundtruth && !o.camera) throw apps::usage_error("--groundtruth needs --camera");
-  if (o.groundtruth && (o.groundtruth_out || o.imu_out || cli.given("--duration")))
-    throw apps::usage_error("--duration, --groundtruth-out and --imu-out are for the synthetic flight only");
+  if (o.groundtruth && (o.groundtruth_out || cli.given("--duration")))
+    throw apps::usage_error("--duration and --groundtruth-out are for the synthetic flight only");
+  for (const char* f : {"--imu-noise", "--imu-rate", "--imu-knot-spacing", "--imu-smoothing"})
+    if (cli.given(f) && !o.imu_out) throw apps::usage_error(std::string(f) + " needs --imu-out");
+  for (const char* f : {"--imu-knot-spacing", "--imu-smoothing"})
+    if (cli.given(f) && !o.groundtruth) throw apps::usage_error(std::string(f) + " needs --groundtruth");
   if (c.wall_density_per_m2 == 0 && c.free_points == 0)
     throw apps::usage_error("--wall-density 0 and --free-points 0 leave the room without landmarks");
   c.validate();  // every field is bounded by its flag above; a failure here is a bug
@@ -140,6 +191,36 @@ void path_box(const std::vector<Eigen::Isometry3d>& poses, const posefuse::Pinho
   }
   lo.array() -= camera.T_BS.translation().norm();
   hi.array() += camera.T_BS.translation().norm();
+}
+
+// Refuses (usage_error) an IMU of more than kMaxImuSamples samples.
+void check_imu_size(const Options& o, double span_s, const std::string& span) {
+  const double n = std::floor(span_s * o.imu_rate_hz) + 1;
+  if (n > kMaxImuSamples)
+    throw apps::usage_error("--imu-rate " + apps::num(o.imu_rate_hz) + " Hz over " + span + " gives " + apps::num(n) +
+                            " IMU samples, more than the " + apps::num(kMaxImuSamples) + " one run may write");
+}
+
+// The IMU synthesised from the ground truth's poses (sim::imu_from_trajectory),
+// from the first row's biases when the file has them.
+std::vector<posefuse::ImuSample> synthesised_imu(const Options& o, const posefuse::EurocGroundTruth& gt) {
+  std::vector<sim::StampedPose> poses(gt.size());
+  for (std::size_t k = 0; k < gt.size(); ++k) {
+    const Eigen::Isometry3d& T = gt.trajectory.poses[k];
+    poses[k] = {gt.t_ns[k], T.translation(), Eigen::Quaterniond(T.linear()).normalized()};
+  }
+  sim::ImuFromTrajectoryConfig c;
+  c.rate_hz = o.imu_rate_hz;
+  c.noise = o.imu_noise;
+  c.seed = o.config.seed;
+  c.knot_spacing_s = o.imu_knot_spacing_s;
+  c.smoothing = o.imu_smoothing;
+  if (gt.has_velocity_and_biases()) c.initial_bias = posefuse::ImuBias{gt.accel_bias->front(), gt.gyro_bias->front()};
+  try {
+    return sim::imu_from_trajectory(poses, c).samples;
+  } catch (const posefuse::invalid_argument& e) {  // fewer than 4 poses
+    throw posefuse::io_error(*o.groundtruth, std::string(e.what()) + " (--imu-out)");
+  }
 }
 
 std::string num(double v) { return posefuse::detail::traj_io::format_number(v); }
@@ -187,10 +268,15 @@ int run(const Options& o, const std::string& program) {
     check_size(o, std::floor(span_s * o.config.rate_hz) + 1, lo, hi,
                "the " + apps::num(span_s) + " s of --groundtruth");
     progress.stage("simulating " + apps::num(std::floor(span_s * o.config.rate_hz) + 1) + " frames");
+    if (o.imu_out) check_imu_size(o, span_s, "the " + apps::num(span_s) + " s of --groundtruth");
     try {
       s = sim::simulate_feature_tracks(gt, camera, o.config);
     } catch (const posefuse::invalid_argument& e) {  // a gap longer than --max-pose-gap
       throw posefuse::io_error(*o.groundtruth, std::string(e.what()) + " (--max-pose-gap)");
+    }
+    if (o.imu_out) {
+      progress.stage("synthesising the IMU");
+      files.add(*o.imu_out, imu_csv(synthesised_imu(o, gt)));
     }
   } else {
     posefuse::sim::ImuSimConfig flight = sim::synthetic_flight();
@@ -202,7 +288,9 @@ int run(const Options& o, const std::string& program) {
     if (o.groundtruth_out)
       files.add(*o.groundtruth_out, groundtruth_csv(sim::synthetic_groundtruth(flight, o.duration_s, 200.0)));
     if (o.imu_out) {
-      flight.noise = posefuse::ImuNoise{};
+      check_imu_size(o, o.duration_s, "--duration " + apps::num(o.duration_s) + " s");
+      flight.noise = o.imu_noise;
+      flight.rate_hz = o.imu_rate_hz;
       flight.seed = o.config.seed;
       files.add(*o.imu_out, imu_csv(sim::simulate_imu(flight, o.duration_s).samples));
     }
