@@ -208,6 +208,8 @@ class BasicPoseSpline {
     Vec3 w;
     return rot(t_s, w);
   }
+  /// \f$ R(t) \f$, and the body angular rate in `omega_body` (one evaluation for both).
+  [[nodiscard]] Rot rotation(double t_s, Vec3& omega_body) const { return rot(t_s, omega_body); }
   /// Body angular rate \f$ \omega(t) \f$ (rad/s, body: \f$ R^\top\dot R = [\omega]_\times \f$).
   [[nodiscard]] Vec3 angular_velocity_body(double t_s) const {
     Vec3 w;
@@ -443,12 +445,14 @@ template <class Lazy = void>
     const double t = double(dk_ns) * 1e-9;
     ImuSample s;
     s.t_ns = spline.t0_ns() + dk_ns;
-    s.accel_mps2 = spline.specific_force_body(t, config.gravity_mps2) + b.accel;
-    s.gyro_radps = spline.angular_velocity_body(t) + b.gyro;
+    Vec3 omega;
+    const auto R = spline.rotation(t, omega);
+    s.accel_mps2 = R.inverse().act(spline.acceleration(t) + Vec3(0, 0, config.gravity_mps2)) + b.accel;
+    s.gyro_radps = omega + b.gyro;
     for (int i = 0; i < 3; ++i) s.accel_mps2(i) += sa * rng.normal();
     for (int i = 0; i < 3; ++i) s.gyro_radps(i) += sg * rng.normal();
     out.samples.push_back(s);
-    out.truth.push_back(ImuTruth{s.t_ns, spline.position(t), spline.velocity(t), spline.rotation(t), b});
+    out.truth.push_back(ImuTruth{s.t_ns, spline.position(t), spline.velocity(t), R, b});
     Vec3 dba, dbg;
     for (int i = 0; i < 3; ++i) dba(i) = sba * rng.normal();
     for (int i = 0; i < 3; ++i) dbg(i) = sbg * rng.normal();
