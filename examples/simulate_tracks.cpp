@@ -118,8 +118,8 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   cli.custom({.name = "--imu-noise", .value = "NA,NG,WA,WG",
               .help = "with --imu-out: accelerometer and gyroscope noise densities, then\n"
                       "their random walks (m/s^2/sqrt(Hz), rad/s/sqrt(Hz), m/s^3/sqrt(Hz),\n"
-                      "rad/s^2/sqrt(Hz)); 0,0,0,0 for a noise-free IMU",
-              .default_text = "2e-3,1.6968e-4,3e-3,1.9393e-5 (EuRoC's ADIS16448)"},
+                      "rad/s^2/sqrt(Hz)), by default EuRoC's ADIS16448; 0,0,0,0: none",
+              .default_text = "2e-3,1.6968e-4,3e-3,1.9393e-5"},
              [&](std::string_view v) {
                double x[4];
                std::size_t start = 0;
