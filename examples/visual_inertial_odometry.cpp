@@ -11,8 +11,16 @@
 //                   --imu V1_01_easy/imu0.csv --groundtruth V1_01_easy/groundtruth_20hz.csv
 //                   --out traj.tum
 //
-// The estimator starts at rest (the first frame after at least 1 s of IMU
-// samples at rest; frames before are "initializing" and not written).
+// --init auto (default) starts at rest when the IMU is at rest before a
+// frame, otherwise in motion (structure from motion on frames with parallax
+// and the visual-inertial alignment); static and dynamic force one of them;
+// groundtruth starts from the --groundtruth file's state at the first frame
+// (17 columns: velocity and biases). Frames before the start are
+// "initializing" and not written. A frame whose state fails a check (too few
+// tracked features for too long, a bias or pose jump beyond its bound, a
+// speed above --max-speed) is "failed": a warning line names the cause and
+// the estimator starts again; the written trajectory has a gap there and the
+// summary counts the starts.
 //
 // Loop closure (posefuse/vio/loop_closure.hpp): --loops FILE reads loop
 // candidates (t_ns_query,t_ns_match csv); --loops recurring-ids derives them
@@ -37,6 +45,7 @@
 // Exit status: 0 ok, 1 bad data (file:line where a file is at fault), 2 bad usage.
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -88,6 +97,8 @@ struct Options {
   posefuse::ImuReadOptions imu_bounds;
   double outside_margin_px = 1.0;
   bool json = false;
+  std::string init = "auto";
+  double max_speed_mps = posefuse::VioEstimatorOptions{}.max_speed_mps;
 };
 
 std::optional<Options> parse_options(const apps::CommandLine& cmd) {
@@ -135,6 +146,18 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
                  throw apps::usage_error("expected cauchy, huber or none, got '" + std::string(v) + "'");
                o.loss = std::string(v);
              });
+  cli.custom({.name = "--init", .value = "auto|static|dynamic|groundtruth",
+              .help = "how the estimator starts (groundtruth: from the --groundtruth file's state)",
+              .default_text = "auto"},
+             [&](std::string_view v) {
+               if (v != "auto" && v != "static" && v != "dynamic" && v != "groundtruth")
+                 throw apps::usage_error("expected auto, static, dynamic or groundtruth, got '" + std::string(v) +
+                                         "'");
+               o.init = std::string(v);
+             });
+  cli.real_in({.name = "--max-speed", .value = "MPS",
+               .help = "a faster estimate is a failure (the estimator starts again)", .unit = "m/s"},
+              o.max_speed_mps, 0.1, 1000.0);
   cli.flag({.name = "--estimate-extrinsic", .help = "estimate the camera-IMU extrinsic too"},
            o.estimate_extrinsic);
   cli.flag({.name = "--no-first-estimate-jacobians",
@@ -184,6 +207,7 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
     throw apps::usage_error("--outlier-px " + apps::num(o.outlier_px) + " is below --pixel-sigma " +
                             apps::num(o.pixel_sigma_px) + ": most true observations would be rejected");
   if ((o.save_map || o.load_map) && !o.loops) throw apps::usage_error("--save-map and --load-map need --loops");
+  if (o.init == "groundtruth" && !o.groundtruth) throw apps::usage_error("--init groundtruth needs --groundtruth");
   o.tracks = *tracks;
   o.camera = *camera;
   o.imu = *imu;
@@ -215,7 +239,109 @@ struct Summary {
   std::size_t dropped = 0;   // observations outside the image, dropped
   bool vision = true;        // some estimated frame used a visual feature
   bool yaw_defined = true;   // the ground truth moves enough to define the alignment's yaw
+  // Starts and failures.
+  int starts = 0;
+  struct Failure {
+    double t_s;
+    std::string why;
+  };
+  std::vector<Failure> failures;
+  struct Start {
+    double t_s;
+    std::string how;
+    double gravity_error_deg = std::numeric_limits<double>::quiet_NaN();  // with a ground truth
+    double scale_error = std::numeric_limits<double>::quiet_NaN();        // with a ground truth, in motion
+  };
+  std::vector<Start> start_details;
+  std::size_t before_imu = 0, after_imu = 0;  // frames outside the IMU's span, not estimated
 };
+
+std::string span_text(std::int64_t a_ns, std::int64_t b_ns) {
+  return apps::num(posefuse::seconds_from_ns(a_ns)) + " to " + apps::num(posefuse::seconds_from_ns(b_ns)) + " s";
+}
+
+// Refuses tracks and an IMU that cannot be run together, naming the cause:
+// too few frames, no overlap in time (with a hint when the stamps differ by
+// a power of 1000: another unit).
+void check_time_overlap(const Options& o, const posefuse::FeatureTracks& tracks,
+                        const std::vector<posefuse::ImuSample>& imu) {
+  if (tracks.size() < 2)
+    throw apps::data_error(o.tracks.string() + ": " + std::to_string(tracks.size()) +
+                           " frame(s); the estimator needs at least 2");
+  const std::int64_t t0 = tracks.front().t_ns, t1 = tracks.back().t_ns;
+  const std::int64_t i0 = imu.front().t_ns, i1 = imu.back().t_ns;
+  if (t1 >= i0 && t0 <= i1) return;
+  std::string hint;
+  const double ratio = double(t0) / double(i0);
+  for (const auto& [r, unit] : {std::pair{1e3, "microseconds"}, std::pair{1e6, "milliseconds"},
+                                std::pair{1e9, "seconds"}}) {
+    if (ratio > 0.5 * r && ratio < 2 * r) hint = " (the IMU stamps look like " + std::string(unit) + "; both files need nanoseconds)";
+    if (ratio < 2 / r && ratio > 0.5 / r)
+      hint = " (the track stamps look like " + std::string(unit) + "; both files need nanoseconds)";
+  }
+  throw apps::data_error("the tracks (" + o.tracks.string() + ", " + span_text(t0, t1) + ") and the IMU (" +
+                         o.imu.string() + ", " + span_text(i0, i1) + ") do not overlap in time" + hint);
+}
+
+// The ground-truth row within 10 ms of `t_ns`, if any.
+std::optional<std::size_t> groundtruth_row(const posefuse::EurocGroundTruth& gt, std::int64_t t_ns) {
+  const auto it = std::lower_bound(gt.t_ns.begin(), gt.t_ns.end(), t_ns);
+  std::optional<std::size_t> best;
+  for (auto c : {it, it == gt.t_ns.begin() ? it : it - 1}) {
+    if (c == gt.t_ns.end() || std::llabs(*c - t_ns) > 10'000'000) continue;
+    if (!best || std::llabs(*c - t_ns) < std::llabs(gt.t_ns[*best] - t_ns)) best = std::size_t(c - gt.t_ns.begin());
+  }
+  return best;
+}
+
+// How good a start was, against the ground truth: the angle between the
+// estimated and the true gravity direction in the newest frame's body, and
+// the scale of the similarity that best maps the start window's positions
+// onto the true ones (Umeyama) minus one, when they span at least 5 cm.
+void grade_start(const posefuse::EurocGroundTruth& gt, const posefuse::VioWindow& w, Summary::Start& s) {
+  const posefuse::VioFrame& f = w.frames.back();
+  if (const auto r = groundtruth_row(gt, f.t_ns)) {
+    const Eigen::Vector3d up_est = f.x.R.matrix().transpose() * Eigen::Vector3d::UnitZ();
+    const Eigen::Vector3d up_ref = gt.trajectory.poses[*r].rotation().transpose() * Eigen::Vector3d::UnitZ();
+    s.gravity_error_deg = std::atan2(up_est.cross(up_ref).norm(), up_est.dot(up_ref)) * 180.0 / std::numbers::pi;
+  }
+  std::vector<Eigen::Vector3d> est, ref;
+  for (const posefuse::VioFrame& x : w.frames) {
+    const auto r = groundtruth_row(gt, x.t_ns);
+    if (!r) return;
+    est.push_back(x.x.p);
+    ref.push_back(gt.trajectory.poses[*r].translation());
+  }
+  double extent = 0;
+  for (const Eigen::Vector3d& p : ref) extent = std::max(extent, (p - ref.front()).norm());
+  if (est.size() < 3 || extent < 0.05) return;
+  try {
+    s.scale_error = posefuse::umeyama_alignment(est, ref, /*with_scale=*/true).scale - 1.0;
+  } catch (const posefuse::invalid_argument&) {
+    // collinear: no scale
+  }
+}
+
+// The ground truth's state at `t_ns` (the row within 10 ms), for --init groundtruth.
+posefuse::ImuState groundtruth_state(const std::filesystem::path& file, const posefuse::EurocGroundTruth& gt,
+                                     std::int64_t t_ns) {
+  if (!gt.velocity)
+    throw posefuse::io_error(file, "--init groundtruth needs the velocity columns (the 17-column EuRoC ground truth)");
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < gt.t_ns.size(); ++i)
+    if (std::llabs(gt.t_ns[i] - t_ns) < std::llabs(gt.t_ns[best] - t_ns)) best = i;
+  if (gt.t_ns.empty() || std::llabs(gt.t_ns[best] - t_ns) > 10'000'000)
+    throw posefuse::io_error(file, "no state within 10 ms of the first frame (" +
+                                       apps::num(posefuse::seconds_from_ns(t_ns)) + " s) for --init groundtruth");
+  posefuse::ImuState x;
+  const Eigen::Isometry3d& T = gt.trajectory.poses[best];
+  x.p = T.translation();
+  x.R = posefuse::SO3d(Eigen::Quaterniond(T.rotation()).normalized());
+  x.v = (*gt.velocity)[best];
+  if (gt.gyro_bias) x.bias.gyro = (*gt.gyro_bias)[best];
+  if (gt.accel_bias) x.bias.accel = (*gt.accel_bias)[best];
+  return x;
+}
 
 double yaw_error_deg(const Eigen::Matrix3d& R_ref, const Eigen::Matrix3d& R_est) {
   const Eigen::Matrix3d E = R_ref * R_est.transpose();  // world-frame error
@@ -385,6 +511,7 @@ int run(const Options& o, const std::string& program) {
   std::optional<posefuse::EurocGroundTruth> gt;
   if (o.groundtruth) gt = posefuse::read_euroc_groundtruth(*o.groundtruth);
   if (imu.empty()) throw apps::data_error(o.imu.string() + ": no IMU sample");
+  check_time_overlap(o, tracks, imu);
 
   posefuse::VioEstimatorOptions eo;
   eo.window.window_size = o.window;
@@ -399,8 +526,18 @@ int run(const Options& o, const std::string& program) {
   eo.window.min_parallax_px = o.min_parallax_px;
   eo.window.outlier_threshold_px = o.outlier_px;
   eo.preintegration.max_gap_ns = std::int64_t(std::llround(o.max_imu_gap_ms * 1e6));
+  eo.init = o.init == "static" ? posefuse::VioInit::kStatic
+            : o.init == "dynamic" ? posefuse::VioInit::kDynamic
+                                  : posefuse::VioInit::kAuto;
+  eo.max_speed_mps = o.max_speed_mps;
   posefuse::VioEstimator est(cam, eo);
   if (o.estimate_extrinsic) est.set_estimate_extrinsic(true);
+  if (o.init == "groundtruth") {
+    // The first frame with IMU samples before it.
+    std::size_t f0 = 0;
+    while (f0 < tracks.size() && tracks[f0].t_ns < imu.front().t_ns) ++f0;
+    est.set_initial_state(groundtruth_state(*o.groundtruth, *gt, tracks[std::min(f0, tracks.size() - 1)].t_ns));
+  }
 
   Summary s;
   s.dropped = track_read.dropped;
@@ -414,19 +551,44 @@ int run(const Options& o, const std::string& program) {
   std::size_t k = 0;
   double total_ms = 0;
   long long visual_features = 0;  // triangulated features over the estimated frames
-  for (std::size_t f = 0; f < tracks.size(); ++f) {
-    if (o.max_frames > 0 && f >= o.max_frames) break;
+  std::string waiting;            // why the last frame was still initializing
+  const std::size_t last = o.max_frames > 0 ? std::min(o.max_frames, tracks.size()) : tracks.size();
+  for (std::size_t f = 0; f < last; ++f) {
     const posefuse::TrackFrame& frame = tracks[f];
+    if (frame.t_ns < imu.front().t_ns) {  // before the IMU: nothing to start from
+      ++s.before_imu;
+      continue;
+    }
+    if (imu.back().t_ns < frame.t_ns) {  // no IMU after this frame
+      s.after_imu = last - f;
+      break;
+    }
     // IMU up to the first sample at or after the frame (the pre-integration interpolates).
     while (k < imu.size() && (k == 0 || imu[k - 1].t_ns < frame.t_ns)) est.add_imu(imu[k++]);
-    if (imu.back().t_ns < frame.t_ns) break;  // no IMU after this frame
     const auto t0 = std::chrono::steady_clock::now();
     const posefuse::VioFrameResult r = est.add_frame(frame);
     if (loops && r.keyframe) loops->add_keyframe(*r.keyframe);
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     ++s.frames;
     ++s.statuses[posefuse::to_string(r.status)];
-    if (r.status == posefuse::VioStatus::kInitializing) continue;
+    if (r.started) {
+      ++s.starts;
+      Summary::Start st{posefuse::seconds_from_ns(frame.t_ns), r.message};
+      if (gt) grade_start(*gt, est.window(), st);
+      s.start_details.push_back(st);
+    }
+    if (r.status == posefuse::VioStatus::kFailed) {
+      const double t_s = posefuse::seconds_from_ns(frame.t_ns);
+      s.failures.push_back(Summary::Failure{t_s, r.message});
+      progress.clear();
+      std::fprintf(stderr, "warning: t = %.3f s: the estimator failed (%s); it starts again\n", t_s,
+                   r.message.c_str());
+      continue;
+    }
+    if (r.status == posefuse::VioStatus::kInitializing) {
+      waiting = r.message;
+      continue;
+    }
     total_ms += ms;
     s.ms_max = std::max(s.ms_max, ms);
     visual_features += r.features;
@@ -444,10 +606,17 @@ int run(const Options& o, const std::string& program) {
   }
   progress.clear();
   std::int64_t last_frame_ns = 0;
-  if (s.frames > 0) last_frame_ns = tracks[s.frames - 1].t_ns;
+  if (s.frames > 0) last_frame_ns = tracks[s.before_imu + s.frames - 1].t_ns;
   if (loops) loops->finish(last_frame_ns);
   s.written = traj.size();
-  if (traj.empty()) throw apps::data_error("no frame was estimated (the IMU is not at rest over the first second?)");
+  if (s.before_imu > 0)
+    std::fprintf(stderr, "warning: %zu frame(s) before the first IMU sample (%s s) not estimated\n", s.before_imu,
+                 apps::num(posefuse::seconds_from_ns(imu.front().t_ns)).c_str());
+  if (s.after_imu > 0)
+    std::fprintf(stderr, "warning: the IMU ends at %s s: %zu frame(s) after it not estimated\n",
+                 apps::num(posefuse::seconds_from_ns(imu.back().t_ns)).c_str(), s.after_imu);
+  if (traj.empty())
+    throw apps::data_error("no frame was estimated" + (waiting.empty() ? std::string() : ": " + waiting));
   s.ms_mean = total_ms / double(s.written);
   s.processing_s = total_ms * 1e-3;
   s.duration_s = traj.t_s.back() - traj.t_s.front();
@@ -537,6 +706,22 @@ int run(const Options& o, const std::string& program) {
     apps::JsonWriter j(std::cout);
     j.begin_object(apps::JsonWriter::Layout::kBlock);
     j.member("frames", s.frames).member("written", s.written);
+    j.member("starts", s.starts).member("frames_before_imu", s.before_imu).member("frames_after_imu", s.after_imu);
+    j.key("start_details").begin_array(apps::JsonWriter::Layout::kBlock);
+    for (const Summary::Start& x : s.start_details) {
+      j.begin_object(apps::JsonWriter::Layout::kInline);
+      j.member("t_s", x.t_s).member("how", x.how);
+      j.member("gravity_error_deg", x.gravity_error_deg).member("scale_error", x.scale_error);
+      j.end_object();
+    }
+    j.end_array();
+    j.key("failures").begin_array(apps::JsonWriter::Layout::kBlock);
+    for (const Summary::Failure& x : s.failures) {
+      j.begin_object(apps::JsonWriter::Layout::kInline);
+      j.member("t_s", x.t_s).member("reason", x.why);
+      j.end_object();
+    }
+    j.end_array();
     j.member("observations_dropped_outside_image", s.dropped).member("vision_used", s.vision);
     j.key("statuses").begin_object(apps::JsonWriter::Layout::kInline);
     for (const auto& [name, n] : s.statuses) j.member(name, n);
@@ -581,6 +766,15 @@ int run(const Options& o, const std::string& program) {
     return 0;
   }
   std::printf("frames                 %zu (%zu estimated)\n", s.frames, s.written);
+  std::printf("starts                 %d", s.starts);
+  if (!s.failures.empty()) std::printf(" (%zu failure(s): the trajectory has a gap at each)", s.failures.size());
+  std::printf("\n");
+  for (const Summary::Start& x : s.start_details) {
+    std::printf("  t = %.3f s: %s", x.t_s, x.how.c_str());
+    if (std::isfinite(x.gravity_error_deg)) std::printf("; gravity error %.2f deg", x.gravity_error_deg);
+    if (std::isfinite(x.scale_error)) std::printf(", scale error %+.1f %%", 100.0 * x.scale_error);
+    std::printf("\n");
+  }
   if (s.dropped > 0) std::printf("dropped                %zu observations outside the image\n", s.dropped);
   if (!s.vision) std::printf("vision                 not used: IMU only\n");
   std::printf("status               ");
