@@ -104,18 +104,20 @@ class BlockProfileCholesky {
     }
   }
 
-  /// Floating-point work of factor() relative to a dense factorisation of
-  /// the same matrix (1 = no saving); used to fall back to a dense solver.
+  /// Floating-point work of factor() relative to a dense Cholesky of the
+  /// same matrix, \f$ n^3/3 \f$ (exactly 1 for a full profile, less for a
+  /// narrower one); used to fall back to a dense solver.
   [[nodiscard]] static double relative_work(const std::vector<int>& first, int t) {
-    const double nb = double(first.size());
-    double w = 0.0;
+    const double nb = double(first.size()), b = B, tb = t;
+    double blocks = 0.0, border = 0.0;
     for (std::size_t i = 0; i < first.size(); ++i) {
-      const double width = double(int(i) - first[i] + 1);
-      w += width * width;
+      const double w = double(int(i) - first[i] + 1);  // blocks in row i, diagonal included
+      blocks += w * w - w + 1.0 / 3.0;
+      border += 2.0 * w - 1.0;
     }
-    const double n = nb * B + t;
-    const double dense = n * n * n / 3.0;
-    return dense > 0 ? (w * B * B * B + (nb * B) * (nb * B) * t) / dense : 1.0;
+    const double n = nb * b + tb;
+    const double work = b * b * b * blocks + tb * b * b * border + tb * tb * nb * b + tb * tb * tb / 3.0;
+    return n > 0 ? work / (n * n * n / 3.0) : 1.0;
   }
 };
 
