@@ -1,11 +1,14 @@
 // bench_vio: one solve of the visual-inertial window (vio/window_problem.hpp),
 // posefuse against Ceres 2.1 on the same residuals from the same start.
 //
-// The window: VioEstimator (default options, explicit initial state) run for
-// 3 s on the synthetic flight (sim::synthetic_flight, EuRoC-like IMU noise)
-// with simulated tracks (sim/feature_tracks.hpp defaults: 20 Hz, 1 px noise,
-// 5 % wrong associations, 150 features per frame); its window after the last
-// frame (10 keyframes + the newest frame, its marginalisation prior, the
+// The window: VioEstimator (default options but the window size N, the
+// argument of each row, and the raw-parallax keyframe test, so that the
+// N = 10 problem is the one measured before the rotation-compensated test
+// existed; explicit initial state) run for 0.3 N s on the synthetic flight
+// (sim::synthetic_flight, EuRoC-like IMU noise) with simulated tracks
+// (sim/feature_tracks.hpp defaults: 20 Hz, 1 px noise, 5 % wrong
+// associations, 150 features per frame); its window after the last frame
+// (N keyframes + the newest frame, its marginalisation prior, the
 // triangulated features; counters `keyframes`, `features`, `observations`)
 // is the problem. The start: every frame moved by 0.05 m in a random
 // direction and 1° about a random axis, velocities by 0.02 m/s, inverse
@@ -15,11 +18,13 @@
 // order), so that both solvers minimise one function with the same
 // derivatives; a row fails if posefuse re-integrated anyway.
 //
-//   BM_WindowSolve/posefuse   copy of the start + WindowProblem::solve (LM,
+//   BM_WindowSolve/posefuse/N copy of the start + WindowProblem::solve (LM,
 //                             inverse depths eliminated by a Schur complement
-//                             on 6x6 blocks, dense LDLT of the reduced system;
-//                             function tolerance 1e-10, at most 100 trials)
-//   BM_WindowSolve/ceres      build a ceres::Problem from the start + Solve
+//                             on 6x6 blocks, block-profile Cholesky of the
+//                             reduced system or dense LLT when the profile is
+//                             wide; function tolerance 1e-10, at most 100
+//                             trials)
+//   BM_WindowSolve/ceres/N    build a ceres::Problem from the start + Solve
 //                             (only when Ceres is found): LM, DENSE_SCHUR with
 //                             the inverse depths eliminated first, one thread,
 //                             function tolerance 1e-10, at most 100 iterations;
@@ -31,14 +36,15 @@
 //                             which scales residual and Jacobian by √ρ′ as
 //                             posefuse does (ρ″ ≤ 0); an observation nearer
 //                             than 0.05 m to its camera contributes zero in both
-//   BM_Marginalize/posefuse   copy of the solved window + marginalize_oldest
+//   BM_Marginalize/posefuse/N copy of the solved window + marginalize_oldest
 //                             (the step that follows a keyframe)
 //
 // Counters: cost = posefuse's F (= 2x Ceres's cost) at the end, iterations
 // (posefuse: LM trials; Ceres: its iterations, iteration 0 not counted). A
 // row fails unless both solvers' final costs agree within a relative 1e-6.
+// N: 10 and 20 (the default window_size of SlidingWindowOptions).
 // Run: bench_vio --benchmark_repetitions=5 --benchmark_enable_random_interleaving=true
-//      --benchmark_report_aggregates_only=true (results in docs/benchmarks.md).
+//      --benchmark_report_aggregates_only=true (results in docs/benchmarks-inertial-vio.md).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -80,10 +86,10 @@ struct Problem {
   int features = 0, observations = 0;
 };
 
-const Problem& problem() {
-  static const Problem p = [] {
+Problem make_problem(int window) {
+  {
     Problem pr;
-    const double duration_s = 3.0;
+    const double duration_s = 0.3 * window;
     sim::ImuSimConfig flight = sim::synthetic_flight();
     flight.noise = ImuNoise{};
     flight.initial_bias = ImuBias{Eigen::Vector3d(0.05, -0.04, 0.03), Eigen::Vector3d(0.002, -0.003, 0.001)};
@@ -92,6 +98,8 @@ const Problem& problem() {
     const sim::SimulatedTracks st = sim::simulate_feature_tracks(flight, duration_s, cam, sim::TrackSimConfig{});
     VioEstimatorOptions eo;
     eo.noise = flight.noise;
+    eo.window.window_size = window;
+    eo.window.rotation_compensated_parallax = false;
     // No re-integration: the IMU residuals stay one function during a solve
     // (Ceres cannot re-integrate); the bias Jacobians correct them to first order.
     eo.preintegration.reintegrate_accel_threshold = 1e9;
@@ -121,8 +129,15 @@ const Problem& problem() {
       pr.observations += int(l.obs.size()) - 1;
     }
     return pr;
-  }();
-  return p;
+  }
+}
+
+// The problem of each window size, built once.
+const Problem& problem(int window) {
+  static std::map<int, Problem> cache;
+  auto it = cache.find(window);
+  if (it == cache.end()) it = cache.emplace(window, make_problem(window)).first;
+  return it->second;
 }
 
 struct Result {
@@ -334,16 +349,18 @@ struct Reference {
 };
 
 // One solve of each, to compare the final costs in every row.
-const Reference& reference() {
-  static const Reference r = [] {
+const Reference& reference(int window) {
+  static std::map<int, Reference> cache;
+  if (const auto it = cache.find(window); it != cache.end()) return it->second;
+  const Reference& r = cache[window] = [window] {
     Reference ref;
-    VioWindow w = problem().start;
+    VioWindow w = problem(window).start;
     WindowProblem P;
     ref.posefuse = solve_posefuse(P, w);
 #ifdef POSEFUSE_HAVE_CERES
     std::vector<double> frames;
     std::map<std::uint64_t, double> depths;
-    ref.ceres = solve_ceres(problem().start, frames, depths);
+    ref.ceres = solve_ceres(problem(window).start, frames, depths);
     ref.have_ceres = true;
 #endif
     return ref;
@@ -351,9 +368,9 @@ const Reference& reference() {
   return r;
 }
 
-bool check(benchmark::State& state, const Result& mine) {
-  const Reference& ref = reference();
-  const Problem& p = problem();
+bool check(benchmark::State& state, int window, const Result& mine) {
+  const Reference& ref = reference(window);
+  const Problem& p = problem(window);
   state.counters["cost"] = mine.cost;
   state.counters["iterations"] = mine.iterations;
   state.counters["keyframes"] = double(p.start.frames.size());
@@ -379,7 +396,7 @@ bool check(benchmark::State& state, const Result& mine) {
 }
 
 void BM_WindowSolve_posefuse(benchmark::State& state) {
-  const Problem& p = problem();
+  const Problem& p = problem(int(state.range(0)));
   WindowProblem P;
   VioWindow w;
   Result r;
@@ -388,13 +405,13 @@ void BM_WindowSolve_posefuse(benchmark::State& state) {
     r = solve_posefuse(P, w);
     benchmark::DoNotOptimize(w.frames.back().x.p.data());
   }
-  (void)check(state, r);
+  (void)check(state, int(state.range(0)), r);
 }
-BENCHMARK(BM_WindowSolve_posefuse)->Name("BM_WindowSolve/posefuse")->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_WindowSolve_posefuse)->Name("BM_WindowSolve/posefuse")->Arg(10)->Arg(20)->Unit(benchmark::kMillisecond);
 
 #ifdef POSEFUSE_HAVE_CERES
 void BM_WindowSolve_ceres(benchmark::State& state) {
-  const Problem& p = problem();
+  const Problem& p = problem(int(state.range(0)));
   std::vector<double> frames;
   std::map<std::uint64_t, double> depths;
   Result r;
@@ -402,13 +419,13 @@ void BM_WindowSolve_ceres(benchmark::State& state) {
     r = solve_ceres(p.start, frames, depths);
     benchmark::DoNotOptimize(frames.data());
   }
-  (void)check(state, r);
+  (void)check(state, int(state.range(0)), r);
 }
-BENCHMARK(BM_WindowSolve_ceres)->Name("BM_WindowSolve/ceres")->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_WindowSolve_ceres)->Name("BM_WindowSolve/ceres")->Arg(10)->Arg(20)->Unit(benchmark::kMillisecond);
 #endif
 
 void BM_Marginalize_posefuse(benchmark::State& state) {
-  const Problem& p = problem();
+  const Problem& p = problem(int(state.range(0)));
   const SlidingWindowOptions o;
   WindowProblem P;
   VioWindow w;
@@ -419,6 +436,6 @@ void BM_Marginalize_posefuse(benchmark::State& state) {
   }
   state.counters["prior_dim"] = w.prior ? double(w.prior->linear.J.cols()) : 0.0;
 }
-BENCHMARK(BM_Marginalize_posefuse)->Name("BM_Marginalize/posefuse")->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Marginalize_posefuse)->Name("BM_Marginalize/posefuse")->Arg(10)->Arg(20)->Unit(benchmark::kMillisecond);
 
 }  // namespace

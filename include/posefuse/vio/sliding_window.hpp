@@ -4,10 +4,23 @@
 /// triangulation, the keyframe test, VINS-Mono's two marginalisation
 /// policies, and outlier removal after a solve.
 ///
+/// **Keyframe test** (Qin et al., "VINS-Mono", T-RO 2018, Sec. IV-B). A
+/// frame is a keyframe when it tracks fewer than `min_tracked` of the
+/// features of the frame before, or when the mean parallax of the shared
+/// features is at least `min_parallax_px` and at least
+/// `min_keyframe_interval_s` have passed since the frame before. With
+/// `rotation_compensated_parallax` (the default) the rotation between the two
+/// frames is removed first: the older frame's bearing $ m_a $ is rotated
+/// into the newer camera by the pre-integrated gyro rotation
+/// $ \Delta R_{ab} $ of the newer frame (it covers exactly the two
+/// frames) and the extrinsic, $ m_a' = \pi(R_{bc}^	op \Delta R_{ab}^	op
+/// R_{bc}\, [m_a; 1]) $, and the parallax is $ |m_b - m_a'| $: a pure
+/// rotation has none, so only translation — what the window needs to
+/// triangulate — makes keyframes. Off, the parallax is the raw $ |m_b - m_a| $.
+///
 /// **Policies** (Qin et al., "VINS-Mono", T-RO 2018, Sec. VI-D). When the
-/// second newest frame is a keyframe — the mean parallax of the features it
-/// shares with the frame before is at least `min_parallax_px`, or it tracks
-/// fewer than `min_tracked` of them — the oldest keyframe is marginalised:
+/// second newest frame is a keyframe (the test above) the oldest keyframe is
+/// marginalised:
 /// its state, the inverse depths anchored at it and every factor touching
 /// them (the prior, the IMU factor to the next keyframe, their reprojection
 /// residuals) are linearised (first-estimate Jacobians for variables already
@@ -34,6 +47,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include <posefuse/graph/marginalization.hpp>
@@ -43,8 +57,18 @@ namespace posefuse {
 
 /// Options of the window's sliding (see the file comment).
 struct SlidingWindowOptions {
-  int window_size = 10;                      ///< keyframes kept, the newest frame not counted
+  /// Keyframes kept, the newest frame not counted. 20: on semi-real EuRoC
+  /// V1_01 (keyframes every 0.07 s on average with the rotation-compensated
+  /// test) the window then spans about 1.4 s instead of 0.6 s, and the
+  /// position+yaw APE falls from 0.113 m (10 keyframes, raw test) to 0.062 m.
+  int window_size = 20;
   double min_parallax_px = 10.0;             ///< keyframe test: mean parallax (px at the focal length)
+  /// Keyframe test: remove the gyro's rotation between the two frames before
+  /// measuring parallax (file comment); false: the raw displacement.
+  bool rotation_compensated_parallax = true;
+  /// Keyframe test: the parallax test makes no keyframe sooner than this
+  /// after the frame before (s); losing track (`min_tracked`) still does.
+  double min_keyframe_interval_s = 0.0;
   int min_tracked = 20;                      ///< keyframe test: fewer shared features makes a keyframe
   double focal_px = 460.0;                   ///< focal length that converts parallax to pixels
   double pixel_sigma_px = 1.0;               ///< σ of the reprojection residuals
@@ -92,17 +116,52 @@ void for_each_shared_displacement(const VioWindow& w, std::uint64_t a, std::uint
   }
 }
 
+/// Mean parallax (px at the focal length) of the features seen by both the
+/// frame at `slot` and the frame at `slot - 1`, and their number. With
+/// `rotation_compensated` the pre-integrated rotation of frames[slot].pre
+/// (which spans the two frames) is removed first (file comment).
+/// `flip_compensation` applies the inverse rotation instead — wrong, for tests.
+[[nodiscard]] inline std::pair<double, int> mean_parallax(const VioWindow& w, std::size_t slot, double focal_px,
+                                                          bool rotation_compensated,
+                                                          bool flip_compensation = false) {
+  if (slot == 0 || slot >= w.frames.size()) return {0.0, 0};
+  // R_{c_b c_a} = R_bc^T ΔR_ab^T R_bc maps a direction of camera a into camera b.
+  const SO3d dR = w.frames[slot].pre.delta().R;
+  const SO3d R_ba = w.T_bc.R.inverse().compose((flip_compensation ? dR : dR.inverse()).compose(w.T_bc.R));
+  const Eigen::Matrix3d M = R_ba.matrix();
+  const std::uint64_t a = w.frames[slot - 1].id, b = w.frames[slot].id;
+  double sum = 0.0;
+  int shared = 0;
+  for (const auto& [id, l] : w.landmarks) {
+    const VioObservation* oa = nullptr;
+    const VioObservation* ob = nullptr;
+    for (const VioObservation& o : l.obs) {
+      if (o.frame_id == a) oa = &o;
+      if (o.frame_id == b) ob = &o;
+    }
+    if (!oa || !ob) continue;
+    Eigen::Vector2d ma = oa->m;
+    if (rotation_compensated) {
+      const Eigen::Vector3d r = M * Eigen::Vector3d(ma.x(), ma.y(), 1.0);
+      // Behind the newer camera after rotation: no meaningful image displacement.
+      if (!(r.z() > 1e-6)) continue;
+      ma = r.head<2>() / r.z();
+    }
+    sum += (ob->m - ma).norm();
+    ++shared;
+  }
+  return {shared > 0 ? sum / shared * focal_px : 0.0, shared};
+}
+
 /// The keyframe test of the file comment for the frame at `slot` against `slot - 1`.
 [[nodiscard]] inline bool is_keyframe(const VioWindow& w, std::size_t slot, const SlidingWindowOptions& o) {
   if (slot == 0) return true;
-  double sum = 0.0;
-  int shared = 0;
-  for_each_shared_displacement(w, w.frames[slot - 1].id, w.frames[slot].id, [&](double d) {
-    sum += d;
-    ++shared;
-  });
+  const auto [parallax, shared] = mean_parallax(w, slot, o.focal_px, o.rotation_compensated_parallax);
   if (shared < o.min_tracked) return true;
-  return sum / shared * o.focal_px >= o.min_parallax_px;
+  if (o.min_keyframe_interval_s > 0 &&
+      double(w.frames[slot].t_ns - w.frames[slot - 1].t_ns) * 1e-9 < o.min_keyframe_interval_s)
+    return false;
+  return parallax >= o.min_parallax_px;
 }
 
 /// Rest test of the frame at `slot` against the keyframe at `ref`: at least

@@ -14,13 +14,32 @@
 /// the extrinsic). The Schur complement
 /// \f[ H_s = H_{cc} - \sum_l \sum_{f, g} w_{l,f} w_{l,g}^\top / h_l, \qquad
 ///     b_s = b_c - \sum_l w_{l,f}\, b_l / h_l \f]
-/// is formed with fixed-size 6x6 products, the dense reduced system
-/// (15 per keyframe, + 6 for the extrinsic) is solved by LDLT, and each λ
-/// is back-substituted: \f$ \delta\lambda_l = -(b_l + \sum_f w_{l,f}^\top \delta_f) / h_l \f$.
+/// is formed with fixed-size 6x6 products and each λ is back-substituted:
+/// \f$ \delta\lambda_l = -(b_l + \sum_f w_{l,f}^\top \delta_f) / h_l \f$.
+///
+/// **The reduced system's profile.** The reduced system has 15 unknowns per
+/// keyframe (+ 6 for the extrinsic) and is sparse by blocks: the IMU factors
+/// couple consecutive keyframes, a feature couples the keyframes that see it
+/// (after the elimination, all of them pairwise), the prior couples the
+/// keyframes it holds, and the extrinsic, when estimated, couples everything.
+/// linearize() records for each keyframe the oldest keyframe it is coupled
+/// to (its block row's profile); the damped system is then assembled on that
+/// lower profile only and factored by a block Cholesky on 15x15 blocks that
+/// keeps the profile (vio/detail/block_profile_cholesky.hpp; the extrinsic
+/// is a dense border): for keyframes whose features span a few keyframes,
+/// the work grows linearly with the window instead of cubically. When the
+/// profile would save less than 30 % of the work of a dense factorisation
+/// (features tracked across most of the window), the lower triangle is
+/// factored densely (LLT). If a Cholesky finds the
+/// damped system not positive definite, it is solved by a dense LDLT (which
+/// also accepts a semi-definite system) and the step is rejected only when
+/// that fails too or gives a non-finite step.
 ///
 /// **Levenberg–Marquardt.** \f$ \mu\,\mathrm{diag}(H) \f$ (each entry clamped to
 /// [1e-6, 1e32], as Ceres does) is added to the Hessian, λ's included, before the elimination. A trial
 /// step is accepted when the cost decreases (μ /= 3), else rejected (μ *= 4).
+/// A rejected trial restores the variables it changed (no copy of the window);
+/// the prior's constant \f$ J^\top J \f$ and \f$ J^\top r_0 \f$ are formed once per solve.
 /// The solve stops after `max_iterations` trials — an iteration cap, never a
 /// clock, so a run gives bit-identical results on any computer — or earlier
 /// when a step changes the cost by less than `function_tolerance` relatively.
@@ -55,6 +74,7 @@
 #include <cmath>
 #include <vector>
 
+#include <posefuse/vio/detail/block_profile_cholesky.hpp>
 #include <posefuse/vio/robust_loss.hpp>
 #include <posefuse/vio/window_state.hpp>
 
@@ -134,27 +154,45 @@ class WindowProblem {
     ext_ = w.estimate_extrinsic ? 15 * int(w.frames.size()) : -1;
     lm_.clear();
     entries_.clear();
+    first_.resize(w.frames.size());
+    for (std::size_t k = 0; k < first_.size(); ++k) first_[k] = int(k);
+    // Couples the keyframe blocks at offsets [oa, ob] (either may be the extrinsic: the border).
+    const auto couple = [&](int oa, int ob) {
+      if (oa == ext_ || ob == ext_) return;
+      const int sa = oa / 15, sb = ob / 15;
+      int& fa = first_[std::size_t(std::max(sa, sb))];
+      fa = std::min(fa, std::min(sa, sb));
+    };
     const auto lin = [&](std::size_t k) -> const ImuState& {
       const VioFrame& f = w.frames[k];
       return o.first_estimate_jacobians && f.fej ? *f.fej : f.x;
     };
     if (sel.prior && w.prior) {
       const VioPrior& p = *w.prior;
-      const Eigen::VectorXd r = prior_residual(w);
+      // J^T J and J^T r0 are constant: formed once per solve (see solve()).
+      if (!prior_cached_) {
+        prior_JtJ_.noalias() = p.linear.J.transpose() * p.linear.J;
+        prior_Jtr0_.noalias() = p.linear.J.transpose() * p.linear.r0;
+      }
+      // J^T r = J^T r0 + J^T J (x ⊖ x̄)
+      prior_Jtr_ = prior_Jtr0_;
+      prior_Jtr_.noalias() += prior_JtJ_ * prior_delta(w);
       int col = 0;
-      std::vector<int> offs;
-      for (const VioPriorBlock& bk : p.blocks) offs.push_back(bk.extrinsic ? ext_ : 15 * w.slot_of(bk.frame_id));
+      prior_offs_.clear();
+      for (const VioPriorBlock& bk : p.blocks) prior_offs_.push_back(bk.extrinsic ? ext_ : 15 * w.slot_of(bk.frame_id));
+      const std::vector<int>& offs = prior_offs_;
       for (std::size_t a = 0; a < p.blocks.size(); ++a) {
         const int da = p.blocks[a].dim();
         int colb = 0;
         for (std::size_t c = 0; c < p.blocks.size(); ++c) {
           const int db = p.blocks[c].dim();
-          if (offs[a] >= 0 && offs[c] >= 0)
-            H_.block(offs[a], offs[c], da, db).noalias() +=
-                p.linear.J.middleCols(col, da).transpose() * p.linear.J.middleCols(colb, db);
+          if (offs[a] >= 0 && offs[c] >= 0) {
+            H_.block(offs[a], offs[c], da, db) += prior_JtJ_.block(col, colb, da, db);
+            couple(offs[a], offs[c]);
+          }
           colb += db;
         }
-        if (offs[a] >= 0) b_.segment(offs[a], da).noalias() += p.linear.J.middleCols(col, da).transpose() * r;
+        if (offs[a] >= 0) b_.segment(offs[a], da) += prior_Jtr_.segment(col, da);
         col += da;
       }
     }
@@ -165,6 +203,7 @@ class WindowProblem {
       const ImuFactor::Residual r = fac.whitened_residual(w.frames[k - 1].x, w.frames[k].x);
       (void)fac.whitened_residual(lin(k - 1), lin(k), &Ji, &Jj);
       const int oi = 15 * int(k - 1), oj = 15 * int(k);
+      couple(oi, oj);
       H_.block<15, 15>(oi, oi).noalias() += Ji.transpose() * Ji;
       H_.block<15, 15>(oj, oj).noalias() += Jj.transpose() * Jj;
       H_.block<15, 15>(oi, oj).noalias() += Ji.transpose() * Jj;
@@ -231,6 +270,11 @@ class WindowProblem {
         lb.h += Jl.squaredNorm();
         lb.b += Jl.dot(r);
       }
+      // After the elimination the feature couples every keyframe it touches pairwise.
+      int lo = ext_ >= 0 ? ext_ : 15 * int(w.frames.size());
+      for (std::size_t e = lb.first; e < entries_.size(); ++e)
+        if (entries_[e].offset != ext_) lo = std::min(lo, entries_[e].offset);
+      for (std::size_t e = lb.first; e < entries_.size(); ++e) couple(lo, entries_[e].offset);
       if (lb.h > 0) lm_.push_back(lb);
       else entries_.resize(lb.first);
     };
@@ -262,12 +306,28 @@ class WindowProblem {
   }
 
   /// Solves the damped system for the camera-side step and back-substitutes
-  /// the inverse depths; returns false when the reduced system is not positive definite.
+  /// the inverse depths (the file comment: profile or dense Cholesky, dense
+  /// LDLT when it fails); returns false when no finite step was found.
   bool solve_step(double mu, Eigen::VectorXd& dx, std::vector<double>& dlambda) {
-    reduce(mu, Hs_, bs_);
-    ldlt_.compute(Hs_);
-    if (ldlt_.info() != Eigen::Success) return false;
-    dx = ldlt_.solve(-bs_);
+    const int t = ext_ >= 0 ? 6 : 0;
+    reduce_lower(mu);
+    dx = -bs_;
+    bool ok = false;
+    if (Profile::relative_work(first_, t) <= kMaxProfileWork) {
+      ok = Profile::factor(Hs_, first_, t);
+      if (ok) Profile::solve(Hs_, first_, t, dx);
+      else reduce_lower(mu);  // factor() overwrote it
+    }
+    if (!ok) {
+      llt_.compute(Hs_);
+      if (llt_.info() == Eigen::Success) {
+        llt_.solveInPlace(dx);
+      } else {
+        ldlt_.compute(Hs_);
+        if (ldlt_.info() != Eigen::Success) return false;
+        ldlt_.solveInPlace(dx);
+      }
+    }
     if (!dx.allFinite()) return false;
     dlambda.resize(lm_.size());
     for (std::size_t i = 0; i < lm_.size(); ++i) {
@@ -280,7 +340,11 @@ class WindowProblem {
     return true;
   }
 
-  /// Applies a step to a copy of the window's variables.
+  /// Block row profile of the reduced system (after linearize()): for each
+  /// keyframe slot, the oldest slot it is coupled to (file comment).
+  [[nodiscard]] const std::vector<int>& profile() const noexcept { return first_; }
+
+  /// Applies a step to the window's variables.
   void apply(VioWindow& w, const Eigen::VectorXd& dx, const std::vector<double>& dlambda) const {
     for (std::size_t k = 0; k < w.frames.size(); ++k) w.frames[k].x = w.frames[k].x.plus(dx.segment<15>(15 * int(k)));
     if (ext_ >= 0) w.T_bc = w.T_bc.plus(dx.segment<6>(ext_));
@@ -314,24 +378,27 @@ class WindowProblem {
     s.repropagated = repropagate(w);
     double F = cost(w, o);
     s.initial_cost = s.final_cost = F;
+    prior_cached_ = false;
     double mu = o.initial_damping;
     bool relinearize = true;
     Eigen::VectorXd dx;
     std::vector<double> dl;
     while (s.iterations < o.max_iterations) {
-      if (relinearize) linearize(w, o);
+      if (relinearize) {
+        linearize(w, o);
+        prior_cached_ = w.prior.has_value();
+      }
       ++s.iterations;
       if (!solve_step(mu, dx, dl)) {
         mu *= 4.0;
         relinearize = false;
         continue;
       }
-      trial_ = w;
-      apply(trial_, dx, dl);
-      const double Ft = cost(trial_, o);
+      save(w);
+      apply(w, dx, dl);
+      const double Ft = cost(w, o);
       if (Ft < F) {
         const double rel = (F - Ft) / std::max(F, 1e-300);
-        std::swap(w, trial_);
         F = Ft;
         ++s.accepted;
         mu = std::max(mu / 3.0, 1e-12);
@@ -343,11 +410,13 @@ class WindowProblem {
           F = cost(w, o);
         }
       } else {
+        restore(w);
         mu *= 4.0;
         relinearize = false;
         if (mu > 1e12) break;
       }
     }
+    prior_cached_ = false;
     s.final_cost = F;
     return s;
   }
@@ -364,7 +433,55 @@ class WindowProblem {
     std::size_t first, count;
   };
 
+  using Profile = detail::BlockProfileCholesky<15>;
+
   static double damped(double h, double mu) noexcept { return h + mu * std::clamp(h, 1e-6, 1e32); }
+
+  /// Profile Cholesky work above this fraction of a dense one: dense LLT.
+  static constexpr double kMaxProfileWork = 0.7;
+
+  /// The damped reduced system's lower triangle (into Hs_, bs_; the strict
+  /// upper triangle is not written: the factorisations read the lower one).
+  void reduce_lower(double mu) {
+    const Eigen::Index D = H_.rows();
+    Hs_.resize(D, D);
+    bs_ = b_;
+    const int nb = int(first_.size());
+    for (int i = 0; i < nb; ++i) {
+      const int fi = first_[std::size_t(i)];
+      Hs_.block(15 * i, 0, 15, 15 * fi).setZero();
+      for (int j = fi; j <= i; ++j) Hs_.block<15, 15>(15 * i, 15 * j) = H_.block<15, 15>(15 * i, 15 * j);
+    }
+    if (ext_ >= 0) Hs_.bottomRows(D - ext_) = H_.bottomRows(D - ext_);
+    if (mu > 0)
+      for (Eigen::Index i = 0; i < D; ++i) Hs_(i, i) += mu * std::clamp(H_(i, i), 1e-6, 1e32);
+    for (const LandmarkBlock& lb : lm_) {
+      const double h = damped(lb.h, mu);
+      for (std::size_t a = lb.first; a < lb.first + lb.count; ++a) {
+        const Entry& ea = entries_[a];
+        bs_.segment<6>(ea.offset) -= ea.w * (lb.b / h);
+        const Vec6 wa = ea.w / h;
+        for (std::size_t c = lb.first; c < lb.first + lb.count; ++c) {
+          const Entry& ec = entries_[c];
+          if (ec.offset <= ea.offset) Hs_.block<6, 6>(ea.offset, ec.offset).noalias() -= wa * ec.w.transpose();
+        }
+      }
+    }
+  }
+
+  /// Keeps the variables a trial step changes, to undo a rejected one.
+  void save(const VioWindow& w) {
+    saved_x_.resize(w.frames.size());
+    for (std::size_t k = 0; k < w.frames.size(); ++k) saved_x_[k] = w.frames[k].x;
+    saved_T_bc_ = w.T_bc;
+    saved_l_.resize(lm_.size());
+    for (std::size_t i = 0; i < lm_.size(); ++i) saved_l_[i] = w.landmarks.at(lm_[i].id).inv_depth;
+  }
+  void restore(VioWindow& w) const {
+    for (std::size_t k = 0; k < w.frames.size(); ++k) w.frames[k].x = saved_x_[k];
+    w.T_bc = saved_T_bc_;
+    for (std::size_t i = 0; i < lm_.size(); ++i) w.landmarks.at(lm_[i].id).inv_depth = saved_l_[i];
+  }
 
   void add_pose_block(int oa, int ob, const Eigen::Matrix<double, 2, 6>& Ja, const Eigen::Matrix<double, 2, 6>& Jb) {
     H_.block<6, 6>(oa, ob).noalias() += Ja.transpose() * Jb;
@@ -390,8 +507,17 @@ class WindowProblem {
   int ext_ = -1;
   std::vector<LandmarkBlock> lm_;
   std::vector<Entry> entries_;
-  Eigen::LDLT<Eigen::MatrixXd> ldlt_;
-  VioWindow trial_;
+  std::vector<int> first_;  // block row profile (see profile())
+  // The prior's J^T J and J^T r0, valid during one solve() (prior_cached_).
+  bool prior_cached_ = false;
+  Eigen::MatrixXd prior_JtJ_;
+  Eigen::VectorXd prior_Jtr0_, prior_Jtr_;
+  std::vector<int> prior_offs_;
+  Eigen::LLT<Eigen::MatrixXd, Eigen::Lower> llt_;
+  Eigen::LDLT<Eigen::MatrixXd, Eigen::Lower> ldlt_;
+  std::vector<ImuState> saved_x_;
+  RigidPose saved_T_bc_;
+  std::vector<double> saved_l_;
 };
 
 }  // namespace posefuse
