@@ -84,13 +84,14 @@ struct Options {
   std::optional<std::string> loops;  // a file, or "recurring-ids"
   double max_imu_gap_ms = 50.0;
   double pixel_sigma_px = 1.0;
-  int window = 10;
+  int window = posefuse::SlidingWindowOptions{}.window_size;
   int iterations = 10;
   std::string loss = "cauchy";
   bool estimate_extrinsic = false;
   bool no_fej = false;
   bool no_reuse = false;
   double min_parallax_px = 10.0;
+  double min_keyframe_interval_s = posefuse::SlidingWindowOptions{}.min_keyframe_interval_s;
   double outlier_px = 5.26;
   std::size_t max_frames = 0;
   posefuse::ImuNoise noise;  // the EuRoC IMU's datasheet figures (imu0 sensor.yaml)
@@ -168,6 +169,9 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
            o.no_reuse);
   cli.real_in({.name = "--min-parallax", .value = "PX", .help = "keyframe parallax", .unit = "px"},
               o.min_parallax_px, 0.1, 1000.0);
+  cli.real_in({.name = "--min-keyframe-interval", .value = "S",
+               .help = "keyframe: at least this long after the one before", .unit = "s"},
+              o.min_keyframe_interval_s, 0.0, 10.0);
   cli.real_in({.name = "--outlier-px", .value = "PX", .help = "reprojection error of an outlier (>= --pixel-sigma)",
                .unit = "px"},
               o.outlier_px, 0.01, 1000.0);
@@ -524,6 +528,7 @@ int run(const Options& o, const std::string& program) {
   eo.window.solve.first_estimate_jacobians = !o.no_fej;
   eo.window.reuse_marginalised_tracks = !o.no_reuse;
   eo.window.min_parallax_px = o.min_parallax_px;
+  eo.window.min_keyframe_interval_s = o.min_keyframe_interval_s;
   eo.window.outlier_threshold_px = o.outlier_px;
   eo.preintegration.max_gap_ns = std::int64_t(std::llround(o.max_imu_gap_ms * 1e6));
   eo.init = o.init == "static" ? posefuse::VioInit::kStatic

@@ -75,6 +75,18 @@ TEST_CASE("visual_inertial_odometry keeps the contract on bad and unusual input"
   (void)dir.write("edge.csv", still_tracks(4.0, "-0.51"));
   (void)dir.write("far.csv", still_tracks(4.0, "-5"));
   (void)dir.write("tiny_focal.yaml", std::string(kCamera).replace(std::string(kCamera).find("458.654"), 7, "1e-300"));
+  {
+    // The same IMU 100 s later, and with its stamps in microseconds.
+    std::string later, micro;
+    for (std::int64_t k = 0; k <= 800; ++k) {
+      later += std::to_string(kT0 + 100'000'000'000 + k * 5000000) + ",0,0,0,0,0,9.81\n";
+      micro += std::to_string(kT0 / 1000 + k * 5000) + ",0,0,0,0,0,9.81\n";
+    }
+    (void)dir.write("later_imu.csv", later);
+    (void)dir.write("micro_imu.csv", micro);
+    (void)dir.write("short_imu.csv", rest_imu(2.5));
+    (void)dir.write("one_frame.csv", still_tracks(0.01));
+  }
   const std::string base = "--tracks '{dir}/t.csv' --camera '{dir}/cam.yaml' --imu '{dir}/imu0.csv' ";
   const std::string out = "--out '{dir}/o.tum' ";
   const std::vector<Probe> probes = {
@@ -120,6 +132,27 @@ TEST_CASE("visual_inertial_odometry keeps the contract on bad and unusual input"
        {"{dir}/two_gt.csv: 2 poses within 10 ms"}, {"umeyama"}, {"{dir}/o.tum"}},
       {"visual_inertial_odometry", base + "--groundtruth '{dir}/still_gt.csv' " + out, 1,
        {"{dir}/still_gt.csv: the ", "cannot be aligned"}, {"umeyama"}, {"{dir}/o.tum"}},
+      // Starts: a mode that does not exist, a ground-truth start without the
+      // ground truth or its velocity, a start in motion on a still camera.
+      {"visual_inertial_odometry", base + "--init sideways", 2,
+       {"--init: expected auto, static, dynamic or groundtruth, got 'sideways'"}, {}},
+      {"visual_inertial_odometry", base + "--init groundtruth " + out, 2, {"--init groundtruth needs --groundtruth"},
+       {}, {"{dir}/o.tum"}},
+      {"visual_inertial_odometry", base + "--init groundtruth --groundtruth '{dir}/still_gt.csv' " + out, 1,
+       {"{dir}/still_gt.csv: --init groundtruth needs the velocity columns"}, {}, {"{dir}/o.tum"}},
+      {"visual_inertial_odometry", base + "--init dynamic " + out, 1,
+       {"no frame was estimated: start in motion: "}, {}, {"{dir}/o.tum"}},
+      // The real cause of a run that cannot start: no overlap in time (with
+      // the unit when it is the cause), one frame; an IMU that ends early.
+      {"visual_inertial_odometry", "--tracks '{dir}/t.csv' --camera '{dir}/cam.yaml' --imu '{dir}/later_imu.csv' " + out,
+       1, {"the tracks ({dir}/t.csv, ", ") do not overlap in time"}, {"look like"}, {"{dir}/o.tum"}},
+      {"visual_inertial_odometry", "--tracks '{dir}/t.csv' --camera '{dir}/cam.yaml' --imu '{dir}/micro_imu.csv' " + out,
+       1, {"do not overlap in time (the IMU stamps look like microseconds; both files need nanoseconds)"}, {},
+       {"{dir}/o.tum"}},
+      {"visual_inertial_odometry", "--tracks '{dir}/one_frame.csv' --camera '{dir}/cam.yaml' --imu '{dir}/imu0.csv' " + out,
+       1, {"{dir}/one_frame.csv: 1 frame(s); the estimator needs at least 2"}, {}, {"{dir}/o.tum"}},
+      {"visual_inertial_odometry", "--tracks '{dir}/t.csv' --camera '{dir}/cam.yaml' --imu '{dir}/short_imu.csv' --json", 0,
+       {"warning: the IMU ends at ", " s: 30 frame(s) after it not estimated"}, {}},
       // A pixel 0.01 px outside the image is dropped, counted and warned
       // about; a still camera triangulates nothing: a warning too.
       {"visual_inertial_odometry", "--tracks '{dir}/edge.csv' --camera '{dir}/cam.yaml' --imu '{dir}/imu0.csv' --json", 0,

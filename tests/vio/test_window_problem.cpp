@@ -302,6 +302,7 @@ TEST_CASE("Keyframe test: the rotation-compensated parallax of a pure rotation i
   const VioWindow w = pure_rotation_window();
   SlidingWindowOptions o;
   o.focal_px = 460.0;
+  o.min_keyframe_interval_s = 0.0;  // the parallax test alone first (the frames are 0.1 s apart)
   const auto [comp, n_comp] = mean_parallax(w, 1, o.focal_px, true);
   const auto [raw, n_raw] = mean_parallax(w, 1, o.focal_px, false);
   const auto [flipped, n_flipped] = mean_parallax(w, 1, o.focal_px, true, true);

@@ -57,18 +57,21 @@ namespace posefuse {
 
 /// Options of the window's sliding (see the file comment).
 struct SlidingWindowOptions {
-  /// Keyframes kept, the newest frame not counted. 20: on semi-real EuRoC
-  /// V1_01 (keyframes every 0.07 s on average with the rotation-compensated
-  /// test) the window then spans about 1.4 s instead of 0.6 s, and the
-  /// position+yaw APE falls from 0.113 m (10 keyframes, raw test) to 0.062 m.
-  int window_size = 20;
+  /// Keyframes kept, the newest frame not counted. With the keyframe
+  /// interval below, 10 keyframes span about 2.5 s: on semi-real EuRoC V1_01
+  /// the position+yaw APE is 0.059 m at 9.9 ms per frame, against 0.103 m
+  /// with no interval (0.6 s) and 0.062 m with 20 keyframes and no interval
+  /// (1.4 s, 37 ms per frame); docs/vio.md has the table.
+  int window_size = 10;
   double min_parallax_px = 10.0;             ///< keyframe test: mean parallax (px at the focal length)
   /// Keyframe test: remove the gyro's rotation between the two frames before
   /// measuring parallax (file comment); false: the raw displacement.
   bool rotation_compensated_parallax = true;
   /// Keyframe test: the parallax test makes no keyframe sooner than this
   /// after the frame before (s); losing track (`min_tracked`) still does.
-  double min_keyframe_interval_s = 0.0;
+  /// 0.25 s makes the window span seconds, so that the scale rests on
+  /// seconds of accelerometer rather than one.
+  double min_keyframe_interval_s = 0.25;
   int min_tracked = 20;                      ///< keyframe test: fewer shared features makes a keyframe
   double focal_px = 460.0;                   ///< focal length that converts parallax to pixels
   double pixel_sigma_px = 1.0;               ///< σ of the reprojection residuals
