@@ -11,14 +11,17 @@
 ///               calibration and the sensor pipelines
 ///  * fusion/  — the gated fuser, fuse_poses and the fuser statuses
 ///  * eval/    — alignment, metrics, planar metrics, statistics
-///  * io/      — association, the trajectory formats, the robot log
 ///
 /// It leaves out, on purpose:
 ///  * inertial/, graph/ and vio/ (pre-integration, pose graphs, the
 ///    visual-inertial estimator): heavy to compile and needed by few
 ///    translation units, so include them one by one;
-///  * the rest of eval/ and io/ (consistency, RPE pairs, EuRoC, KITTI, g2o
-///    and camera readers): include the one you use;
+///  * io/ (the file readers and writers: trajectory formats, association,
+///    the robot log, EuRoC, KITTI, g2o, cameras): they bring file streams
+///    and parsers that estimation code does not need, so include the one
+///    you use (<posefuse/io/formats.hpp> reads and writes every trajectory
+///    format);
+///  * the rest of eval/ (consistency, RPE pairs): include the one you use;
 ///  * testing/ (the conformance harness and test references), sim/ (the
 ///    simulators) and seed/ (the source documents' formulas as printed, kept
 ///    apart from the recommended API).
@@ -49,9 +52,6 @@
 #include <posefuse/fusion/fuse_poses.hpp>
 #include <posefuse/fusion/fuser_status.hpp>
 #include <posefuse/fusion/gated_fuser.hpp>
-#include <posefuse/io/association.hpp>
-#include <posefuse/io/formats.hpp>
-#include <posefuse/io/robot_log.hpp>
 #include <posefuse/lie/lie.hpp>
 #include <posefuse/models/constant_velocity.hpp>
 #include <posefuse/models/ctrv.hpp>

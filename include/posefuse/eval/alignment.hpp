@@ -102,44 +102,53 @@ template <class Lazy = void>
     throw invalid_argument("umeyama_alignment: needs at least 3 point pairs, got " +
                            std::to_string(x.size()));
   }
+  // Dependent spellings: the SVD and the expressions compile only where
+  // this is called (core/lazy.hpp).
+  using Vec3 = detail::dependent_t<Eigen::Vector3d, Lazy>;
+  using Mat3 = detail::dependent_t<Eigen::Matrix3d, Lazy>;
   const double n = static_cast<double>(x.size());
-  Eigen::Vector3d mean_x = Eigen::Vector3d::Zero();
-  Eigen::Vector3d mean_y = Eigen::Vector3d::Zero();
+  Vec3 mean_x = Vec3::Zero();
+  Vec3 mean_y = Vec3::Zero();
   for (std::size_t i = 0; i < x.size(); ++i) {
-    if (!x[i].allFinite() || !y[i].allFinite()) {
+    const Vec3& xi = x[i];
+    const Vec3& yi = y[i];
+    if (!xi.allFinite() || !yi.allFinite()) {
       throw invalid_argument("umeyama_alignment: point pair " + std::to_string(i) +
                              " is not finite");
     }
-    mean_x += x[i];
-    mean_y += y[i];
+    mean_x += xi;
+    mean_y += yi;
   }
   mean_x /= n;
   mean_y /= n;
   double sigma_x = 0.0;
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  Mat3 cov = Mat3::Zero();
   for (std::size_t i = 0; i < x.size(); ++i) {
-    const Eigen::Vector3d dx = x[i] - mean_x;
+    const Vec3& xi = x[i];
+    const Vec3& yi = y[i];
+    const Vec3 dx = xi - mean_x;
     sigma_x += dx.squaredNorm();
-    cov += (y[i] - mean_y) * dx.transpose();
+    cov += (yi - mean_y) * dx.transpose();
   }
   sigma_x /= n;
   cov /= n;
 
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(cov, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  const Eigen::Vector3d d = svd.singularValues();
+  const Eigen::JacobiSVD<Mat3> svd(cov, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Vec3 d = svd.singularValues();
   int rank = 0;
   for (int i = 0; i < 3; ++i) rank += d(i) > std::numeric_limits<double>::epsilon() ? 1 : 0;
   if (rank < 2) {
     throw invalid_argument("umeyama_alignment: degenerate covariance rank " + std::to_string(rank) +
                            " (points identical or collinear), alignment is not possible");
   }
-  Eigen::Matrix3d S = Eigen::Matrix3d::Identity();
+  Mat3 S = Mat3::Identity();
   if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0.0) S(2, 2) = -1.0;
 
   AlignmentResult r;
-  r.rotation = svd.matrixU() * S * svd.matrixV().transpose();
+  const Mat3 R = svd.matrixU() * S * svd.matrixV().transpose();
+  r.rotation = R;
   r.scale = with_scale ? (d.asDiagonal() * S).trace() / sigma_x : 1.0;
-  r.translation = mean_y - r.scale * (r.rotation * mean_x);
+  r.translation = mean_y - r.scale * (R * mean_x);
   return r;
 }
 

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include <posefuse/core/error.hpp>
+#include <posefuse/core/lazy.hpp>
 
 namespace posefuse {
 
@@ -96,18 +97,20 @@ template <class Lazy = void>
 /// PoseRelation; the point-distance relations, which compare distances
 /// rather than poses, give \f$ \lVert t(E) \rVert \f$ here).
 template <class Lazy = void>
-[[nodiscard]] double pose_error(const Eigen::Isometry3d& E, PoseRelation relation) noexcept {
+[[nodiscard]] double pose_error(const Eigen::Isometry3d& pose, PoseRelation relation) noexcept {
+  // Dependent spelling: compiled only where called (core/lazy.hpp).
+  const detail::dependent_t<Eigen::Isometry3d, Lazy>& E = pose;
   switch (relation) {
     case PoseRelation::kTranslation: return E.translation().norm();
     case PoseRelation::kRotationAngleDeg:
       return rotation_angle(E.linear()) * 180.0 / std::numbers::pi;
     case PoseRelation::kRotationAngleRad: return rotation_angle(E.linear());
-    case PoseRelation::kRotationPart: return (E.linear() - Eigen::Matrix3d::Identity()).norm();
+    case PoseRelation::kRotationPart: return (E.linear() - detail::dependent_t<Eigen::Matrix3d, Lazy>::Identity()).norm();
     case PoseRelation::kPointDistance:
     case PoseRelation::kPointDistanceErrorRatio: return E.translation().norm();
     case PoseRelation::kFull: break;
   }
-  return (E.matrix() - Eigen::Matrix4d::Identity()).norm();
+  return (E.matrix() - detail::dependent_t<Eigen::Matrix4d, Lazy>::Identity()).norm();
 }
 
 }  // namespace posefuse

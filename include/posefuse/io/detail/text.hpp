@@ -22,6 +22,7 @@
 #include <vector>
 
 #include <posefuse/core/error.hpp>
+#include <posefuse/core/lazy.hpp>
 #include <posefuse/io/detail/line_reader.hpp>
 #include <posefuse/io/read_options.hpp>
 #include <posefuse/io/detail/message_number.hpp>
@@ -234,22 +235,24 @@ template <class Lazy = void>
 [[nodiscard]] Eigen::Matrix3d checked_rotation(const Eigen::Matrix3d& R, double tolerance,
                                                const std::filesystem::path& file,
                                                std::size_t line) {
-  const double residual = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  using Mat3 = dependent_t<Eigen::Matrix3d, Lazy>;  // compiled where called (core/lazy.hpp)
+  const Mat3& Rd = R;
+  const double residual = (Rd.transpose() * Rd - Mat3::Identity()).cwiseAbs().maxCoeff();
   if (!(residual <= tolerance)) {
     throw io_error(file, line,
                    "rotation is not orthonormal: max |R^T R - I| = " + message_number(residual) +
                        " exceeds the tolerance " + message_number(tolerance));
   }
-  const double det = R.determinant();
+  const double det = Rd.determinant();
   if (!(det > 0.0)) {
     throw io_error(file, line, "rotation is a reflection (det R = " + message_number(det) + ")");
   }
   if (residual <= kExactlyOrthonormal) return R;
-  Eigen::Matrix3d X = R;
+  Mat3 X = Rd;
   // Quadratic convergence: the change halves its exponent every step; stop
   // once it is at rounding level (at most 8 steps, 3 for tolerance 1e-3).
   for (int k = 0; k < 8; ++k) {
-    const Eigen::Matrix3d next = 0.5 * (X + X.inverse().transpose());
+    const Mat3 next = 0.5 * (X + X.inverse().transpose());
     const double change = (next - X).cwiseAbs().maxCoeff();
     X = next;
     if (change <= 1e-15) break;
