@@ -164,11 +164,9 @@ int main(int argc, char** argv) {
     cli.epilogue("Exit status: 0 ok, 1 bad data (the file is named), 2 bad usage.");
     if (!cli.parse(cmd)) return 0;
     if (files.empty()) throw apps::usage_error("give at least one --result FILE");
-    for (std::size_t start = 0; !label_list.empty() && start <= label_list.size();) {
-      const std::size_t comma = std::min(label_list.find(',', start), label_list.size());
-      labels.push_back(label_list.substr(start, comma - start));
-      start = comma + 1;
-    }
+    if (!label_list.empty())
+      for (const std::string_view label : apps::split_commas(label_list, 1, label_list.size() + 1, "A,B,..."))
+        labels.emplace_back(label);
     if (!labels.empty() && labels.size() != files.size())
       throw apps::usage_error("--label names " + std::to_string(labels.size()) + " results but " +
                               std::to_string(files.size()) + " are given");

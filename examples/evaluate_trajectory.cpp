@@ -75,12 +75,9 @@ struct Options : apps::EvaluationSetup {
 
 /// "D,A" -> (D, A), both finite and >= 0.
 std::pair<double, double> parse_pair(std::string_view v) {
-  const auto comma = v.find(',');
-  if (comma == std::string_view::npos)
-    throw apps::usage_error("expected DIST,ANGLE (two numbers separated by a comma), got '" +
-                            std::string(v) + "'");
-  return {apps::parse_real(v.substr(0, comma), apps::Domain::kNonNegative),
-          apps::parse_real(v.substr(comma + 1), apps::Domain::kNonNegative)};
+  const auto items = apps::split_commas(v, 2, 2, "DIST,ANGLE (two numbers separated by a comma)");
+  return {apps::parse_real(items[0], apps::Domain::kNonNegative),
+          apps::parse_real(items[1], apps::Domain::kNonNegative)};
 }
 
 /// The options, or nothing when --help was printed.

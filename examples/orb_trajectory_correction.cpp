@@ -110,9 +110,9 @@ double parse_noise(std::string_view text) {
 
 /// "VAR" or "VAR,VAR": a diagonal covariance, each variance in [kMinNoise, kMaxNoise].
 Eigen::Matrix2d parse_diag(std::string_view text) {
-  const auto comma = text.find(',');
-  const double a = parse_noise(text.substr(0, comma));
-  const double b = comma == std::string_view::npos ? a : parse_noise(text.substr(comma + 1));
+  const auto items = apps::split_commas(text, 1, 2, "VAR or VAR,VAR");
+  const double a = parse_noise(items[0]);
+  const double b = items.size() == 1 ? a : parse_noise(items[1]);
   return Eigen::Vector2d(a, b).asDiagonal();
 }
 

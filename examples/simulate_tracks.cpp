@@ -33,6 +33,7 @@
 #include <vector>
 
 #include <apps/cli.hpp>
+#include <apps/imu_flags.hpp>
 #include <apps/json.hpp>
 #include <apps/output_file.hpp>
 #include <apps/progress.hpp>
@@ -120,20 +121,7 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
                       "their random walks (m/s^2/sqrt(Hz), rad/s/sqrt(Hz), m/s^3/sqrt(Hz),\n"
                       "rad/s^2/sqrt(Hz)), by default EuRoC's ADIS16448; 0,0,0,0: none",
               .default_text = "2e-3,1.6968e-4,3e-3,1.9393e-5"},
-             [&](std::string_view v) {
-               double x[4];
-               std::size_t start = 0;
-               for (int i = 0; i < 4; ++i) {
-                 const std::size_t comma = i < 3 ? v.find(',', start) : v.size();
-                 if (comma == std::string_view::npos || (i == 3 && v.find(',', start) != std::string_view::npos))
-                   throw apps::usage_error("expected four comma-separated numbers, got '" + std::string(v) + "'");
-                 x[i] = apps::parse_real(v.substr(start, comma - start), apps::Domain::kNonNegative);
-                 if (!(x[i] <= 100.0))
-                   throw apps::usage_error("each value must be from 0 to 100, got '" + std::string(v) + "'");
-                 start = comma + 1;
-               }
-               o.imu_noise = posefuse::ImuNoise{x[1], x[0], x[3], x[2]};
-             });
+             [&](std::string_view v) { o.imu_noise = apps::parse_imu_noise(v, 0.0); });
   cli.real_in({.name = "--imu-rate", .value = "HZ", .help = "with --imu-out: IMU sample rate", .unit = "Hz"},
               o.imu_rate_hz, 1.0, 10000.0);
   cli.real_in({.name = "--imu-knot-spacing", .value = "S",

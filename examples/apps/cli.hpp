@@ -123,6 +123,28 @@ template <std::integral T>
   return v;
 }
 
+/// The items of a comma-separated list ("A,B,C"; an empty text is one empty
+/// item), views into `text`.
+/// @param[in] text      the flag's value
+/// @param[in] min_items fewest items accepted
+/// @param[in] max_items most items accepted
+/// @param[in] expected  what a valid value looks like, for the message
+/// @return the items, in order
+/// @throws usage_error "expected <expected>, got '<text>'" for another count
+[[nodiscard]] inline std::vector<std::string_view> split_commas(std::string_view text, std::size_t min_items,
+                                                                std::size_t max_items, std::string_view expected) {
+  std::vector<std::string_view> items;
+  for (std::size_t start = 0;;) {
+    const std::size_t comma = std::min(text.find(',', start), text.size());
+    items.push_back(text.substr(start, comma - start));
+    if (comma == text.size()) break;
+    start = comma + 1;
+  }
+  if (items.size() < min_items || items.size() > max_items)
+    throw usage_error("expected " + std::string(expected) + ", got '" + std::string(text) + "'");
+  return items;
+}
+
 /// Shortest text that reads back to the same double (std::to_chars; "inf"
 /// and "nan" for non-finite values). Used for defaults in `--help`.
 [[nodiscard]] inline std::string shortest(double v) {

@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include <apps/cli.hpp>
+#include <apps/imu_flags.hpp>
 #include <apps/json.hpp>
 #include <apps/output_file.hpp>
 #include <apps/svg.hpp>
@@ -351,6 +352,28 @@ TEST_CASE("apps::Parser: declaring a flag twice or a bad name is a programming e
   CHECK_THROWS_AS(cli.flag({.name = "--help", .help = "mine"}, a), std::logic_error);
   CHECK_THROWS_AS(cli.flag({.name = "-b", .help = "short"}, a), std::logic_error);
   CHECK_THROWS_AS(cli.flag({.name = "--b=c", .help = "eq"}, a), std::logic_error);
+}
+
+TEST_CASE("apps::split_commas: items in order, empty ones kept, the count bounded", "[examples][cli]") {
+  using V = std::vector<std::string_view>;
+  CHECK(apps::split_commas("a,b,c", 1, 5, "x") == V{"a", "b", "c"});
+  CHECK(apps::split_commas("", 1, 1, "x") == V{""});
+  CHECK(apps::split_commas("a,,b,", 1, 5, "x") == V{"a", "", "b", ""});
+  CHECK_THROWS_WITH(apps::split_commas("1,2,3", 2, 2, "DIST,ANGLE"), "expected DIST,ANGLE, got '1,2,3'");
+  CHECK_THROWS_WITH(apps::split_commas("1", 2, 2, "DIST,ANGLE"), "expected DIST,ANGLE, got '1'");
+}
+
+TEST_CASE("apps::parse_imu_noise: four values in [lo, 100], stored where ImuNoise keeps them", "[examples][cli]") {
+  const posefuse::ImuNoise n = apps::parse_imu_noise("1,2,3,4", 1e-8);
+  CHECK(n.accel_noise_density == 1.0);
+  CHECK(n.gyro_noise_density == 2.0);
+  CHECK(n.accel_random_walk == 3.0);
+  CHECK(n.gyro_random_walk == 4.0);
+  CHECK(apps::parse_imu_noise("0,0,0,0", 0.0).gyro_noise_density == 0.0);  // a noise-free simulator
+  CHECK_THROWS_AS(apps::parse_imu_noise("0,0,0,0", 1e-8), apps::usage_error);
+  CHECK_THROWS_WITH(apps::parse_imu_noise("1,2,3", 0.0), "expected four comma-separated numbers, got '1,2,3'");
+  CHECK_THROWS_WITH(apps::parse_imu_noise("1,2,3,101", 0.0), "each value must be from 0 to 100, got '1,2,3,101'");
+  CHECK_THROWS_AS(apps::parse_imu_noise("1,2,x,4", 0.0), apps::usage_error);
 }
 
 TEST_CASE("apps::parse_real does not depend on the C locale", "[examples][cli]") {

@@ -47,6 +47,7 @@
 #include <vector>
 
 #include <posefuse/core/error.hpp>
+#include <posefuse/io/detail/csv.hpp>
 #include <posefuse/core/samples.hpp>
 #include <posefuse/core/time.hpp>
 #include <posefuse/core/trajectory.hpp>
@@ -123,40 +124,6 @@ void check_imu_bounds(const Eigen::Vector3d& gyro, const Eigen::Vector3d& accel,
                       const ImuReadOptions& bounds = {}) {
   check_bound(gyro, bounds.max_abs_angular_rate, gyro_what, "rad/s", file, line);
   check_bound(accel, bounds.max_abs_specific_force, accel_what, "m/s^2", file, line);
-}
-
-/// Splits a csv line at commas, trimming spaces and tabs around each field.
-template <class Lazy = void>
-[[nodiscard]] std::vector<std::string_view> split_csv(std::string_view line) {
-  std::vector<std::string_view> out;
-  std::size_t start = 0;
-  for (;;) {
-    const std::size_t comma = line.find(',', start);
-    std::string_view f = line.substr(start, comma == std::string_view::npos ? line.npos : comma - start);
-    while (!f.empty() && (f.front() == ' ' || f.front() == '\t')) f.remove_prefix(1);
-    while (!f.empty() && (f.back() == ' ' || f.back() == '\t')) f.remove_suffix(1);
-    out.push_back(f);
-    if (comma == std::string_view::npos) break;
-    start = comma + 1;
-  }
-  return out;
-}
-
-/// Parses an integer nanosecond stamp.
-/// @throws posefuse::io_error naming file, line and column 1
-template <class Lazy = void>
-[[nodiscard]] std::int64_t parse_stamp(std::string_view token, const std::filesystem::path& file,
-                                       std::size_t line) {
-  std::int64_t v = 0;
-  const char* const end = token.data() + token.size();
-  const auto [ptr, ec] = std::from_chars(token.data(), end, v);
-  if (ec == std::errc::result_out_of_range)
-    throw io_error(file, line, "timestamp '" + std::string(token) + "' does not fit in int64 ns");
-  if (ec != std::errc{} || ptr != end || token.empty())
-    throw io_error(file, line,
-                   "cannot parse '" + std::string(token) +
-                       "' in column 1 as an integer timestamp in nanoseconds");
-  return v;
 }
 
 /// Tokenises and parses one data line: the stamp and the remaining numbers.
@@ -256,7 +223,7 @@ template <class Lazy = void>
     if (detail::traj_io::is_blank_or_comment(line)) continue;
     const std::size_t n = reader.line_no();
     if (columns == 0) {
-      columns = detail::euroc_io::split_csv(line).size();
+      columns = detail::split_csv(line).size();
       if (columns != 8 && columns != 17)
         throw io_error(file, n,
                        "expected 8 fields (t[ns], p xyz, q wxyz) or 17 (+ v xyz, b_gyro xyz, "

@@ -46,6 +46,7 @@
 #include <vector>
 
 #include <posefuse/core/error.hpp>
+#include <posefuse/io/detail/csv.hpp>
 #include <posefuse/io/detail/line_reader.hpp>
 #include <posefuse/io/detail/message_number.hpp>
 #include <posefuse/io/detail/text.hpp>
@@ -133,7 +134,7 @@ template <class Lazy = void>
   while (reader.next(line)) {
     if (detail::traj_io::is_blank_or_comment(line)) continue;
     const std::size_t n = reader.line_no();
-    const std::vector<std::string_view> f = detail::euroc_io::split_csv(line);
+    const std::vector<std::string_view> f = detail::split_csv(line);
     if (first) {
       first = false;
       if (f.size() == 4 && f[0] == "t_ns" && f[1] == "feature_id" && f[2] == "u" && f[3] == "v")
@@ -143,7 +144,7 @@ template <class Lazy = void>
       throw io_error(file, n,
                      "expected 4 comma-separated fields (t_ns, feature_id, u, v), found " +
                          std::to_string(f.size()));
-    const std::int64_t t = detail::euroc_io::parse_stamp(f[0], file, n);
+    const std::int64_t t = detail::parse_stamp(f[0], file, n);
     FeatureObservation o;
     o.id = detail::tracks_io::parse_id(f[1], file, n);
     o.uv = Eigen::Vector2d(detail::traj_io::parse_number(f[2], file, n, 3),

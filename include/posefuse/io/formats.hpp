@@ -10,6 +10,7 @@
 #include <string_view>
 
 #include <posefuse/core/error.hpp>
+#include <posefuse/io/detail/csv.hpp>
 #include <posefuse/io/euroc.hpp>
 #include <posefuse/io/kitti.hpp>
 #include <posefuse/io/read_options.hpp>
@@ -78,7 +79,7 @@ template <class Lazy = void>
     Format format;
     std::size_t fields = 0;
     if (line.find(',') != std::string::npos) {
-      const std::vector<std::string_view> f = detail::euroc_io::split_csv(line);
+      const std::vector<std::string_view> f = detail::split_csv(line);
       fields = f.size();
       const bool integer_stamp = !f[0].empty() && f[0].find_first_not_of("0123456789") == std::string_view::npos;
       if ((fields != 8 && fields != 17) || !integer_stamp) {

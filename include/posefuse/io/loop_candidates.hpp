@@ -32,6 +32,7 @@
 #include <vector>
 
 #include <posefuse/core/error.hpp>
+#include <posefuse/io/detail/csv.hpp>
 #include <posefuse/io/detail/line_reader.hpp>
 #include <posefuse/io/detail/text.hpp>
 #include <posefuse/io/euroc.hpp>
@@ -63,7 +64,7 @@ template <class Lazy = void>
   while (reader.next(line)) {
     if (detail::traj_io::is_blank_or_comment(line)) continue;
     const std::size_t n = reader.line_no();
-    const std::vector<std::string_view> f = detail::euroc_io::split_csv(line);
+    const std::vector<std::string_view> f = detail::split_csv(line);
     if (first) {
       first = false;
       if (f.size() == 2 && f[0] == "t_ns_query" && f[1] == "t_ns_match") continue;
@@ -72,9 +73,9 @@ template <class Lazy = void>
       throw io_error(file, n,
                      "expected 2 comma-separated fields (t_ns_query, t_ns_match), found " + std::to_string(f.size()));
     LoopCandidate c;
-    c.t_query_ns = detail::euroc_io::parse_stamp(f[0], file, n);
+    c.t_query_ns = detail::parse_stamp(f[0], file, n);
     try {
-      c.t_match_ns = detail::euroc_io::parse_stamp(f[1], file, n);
+      c.t_match_ns = detail::parse_stamp(f[1], file, n);
     } catch (const io_error&) {
       throw io_error(file, n, "cannot parse '" + std::string(f[1]) +
                                   "' in column 2 as an integer timestamp in nanoseconds");

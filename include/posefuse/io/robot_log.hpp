@@ -83,13 +83,13 @@ template <class Lazy = void>
   for (const auto& [n, full] : detail::read_content_lines(file)) {
     std::string_view text = full;
     if (const std::size_t h = text.find('#'); h != std::string_view::npos)
-      text = detail::trim(text.substr(0, h));
+      text = detail::trim_blanks(text.substr(0, h));
     const std::size_t sp = text.find_first_of(" \t=");
     if (sp == std::string_view::npos)
       throw io_error(file, n, "expected 'key value', got '" + std::string(text) + "'");
-    const std::string key = detail::lower(detail::trim(text.substr(0, sp)));
-    std::string_view val = detail::trim(text.substr(sp + 1));
-    if (!val.empty() && val.front() == '=') val = detail::trim(val.substr(1));
+    const std::string key = detail::lower(detail::trim_blanks(text.substr(0, sp)));
+    std::string_view val = detail::trim_blanks(text.substr(sp + 1));
+    if (!val.empty() && val.front() == '=') val = detail::trim_blanks(val.substr(1));
     Key* k = nullptr;
     for (Key& c : keys) {
       if (c.name == key) k = &c;

@@ -19,18 +19,12 @@
 #include <vector>
 
 #include <posefuse/core/error.hpp>
+#include <posefuse/io/detail/csv.hpp>
 #include <posefuse/io/detail/line_reader.hpp>
 
 namespace posefuse {
 
 namespace detail {
-
-template <class Lazy = void>
-std::string_view trim(std::string_view s) noexcept {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
-  return s;
-}
 
 template <class Lazy = void>
 std::string lower(std::string_view s) {
@@ -52,23 +46,11 @@ std::vector<std::pair<std::size_t, std::string>> read_content_lines(
   std::vector<std::pair<std::size_t, std::string>> lines;
   std::string line;
   while (in.next(line)) {
-    const std::string_view t = trim(line);
+    const std::string_view t = trim_blanks(line);
     if (t.empty() || t.front() == '#') continue;
     lines.emplace_back(in.line_no(), std::string(t));
   }
   return lines;
-}
-
-template <class Lazy = void>
-std::vector<std::string_view> split_csv(std::string_view s) {
-  std::vector<std::string_view> out;
-  for (;;) {
-    const std::size_t c = s.find(',');
-    out.push_back(trim(s.substr(0, c)));
-    if (c == std::string_view::npos) break;
-    s.remove_prefix(c + 1);
-  }
-  return out;
 }
 
 /// A cursor over one CSV data line that parses its fields in order.

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include <posefuse/core/error.hpp>
+#include <posefuse/io/detail/csv.hpp>
 #include <posefuse/io/detail/line_reader.hpp>
 
 namespace posefuse::detail::sensor_yaml {
@@ -68,15 +69,9 @@ template <class Lazy = void>
   return out;
 }
 
-[[nodiscard]] inline std::string_view trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
-  return s;
-}
-
 /// A scalar without its surrounding quotes.
 [[nodiscard]] inline std::string unquote(std::string_view s) {
-  s = trim(s);
+  s = trim_blanks(s);
   if (s.size() >= 2 && (s.front() == '"' || s.front() == '\'') && s.back() == s.front())
     return std::string(s.substr(1, s.size() - 2));
   return std::string(s);
@@ -84,10 +79,10 @@ template <class Lazy = void>
 
 /// `s` without a leading tag (`!!opencv-matrix`, `!foo`).
 [[nodiscard]] inline std::string_view drop_tag(std::string_view s) {
-  s = trim(s);
+  s = trim_blanks(s);
   if (!s.empty() && s.front() == '!') {
     const std::size_t sp = s.find_first_of(" \t");
-    s = sp == std::string_view::npos ? std::string_view{} : trim(s.substr(sp));
+    s = sp == std::string_view::npos ? std::string_view{} : trim_blanks(s.substr(sp));
   }
   return s;
 }
@@ -156,7 +151,7 @@ void flow_list_items(const std::vector<std::pair<char, std::size_t>>& chars, Val
   std::size_t cur_line = 0;
   bool after_close = false;  // the last token was a ']' (a comma may follow)
   const auto flush = [&](std::size_t line, bool at_comma) {
-    const std::string item(trim(cur));
+    const std::string item(trim_blanks(cur));
     cur.clear();
     if (item.empty()) {
       if (at_comma && !after_close) throw io_error(file, line, "empty item in a list");
@@ -185,7 +180,7 @@ void flow_list_items(const std::vector<std::pair<char, std::size_t>>& chars, Val
       continue;
     }
     if (ch == '"' || ch == '\'') quote = ch;
-    if (ch != ' ' && ch != '\t' && trim(cur).empty()) cur_line = line;
+    if (ch != ' ' && ch != '\t' && trim_blanks(cur).empty()) cur_line = line;
     if (ch != ' ' && ch != '\t') after_close = false;
     cur += ch;
   }
@@ -272,7 +267,7 @@ void parse_value(const std::vector<Line>& lines, std::size_t& i, std::size_t ind
       v.is_list = true;
       const std::size_t list_indent = lines[i].indent;
       while (i < lines.size() && lines[i].indent == list_indent && lines[i].text.front() == '-') {
-        const std::string item(trim(std::string_view(lines[i].text).substr(1)));
+        const std::string item(trim_blanks(std::string_view(lines[i].text).substr(1)));
         if (item.empty() || item.front() == '[' || item.front() == '{' ||
             (item.find(": ") != std::string::npos && item.front() != '"' && item.front() != '\''))
           throw io_error(file, lines[i].no, "block list items must be single values");
