@@ -147,9 +147,17 @@ std::vector<SE2<double>> read_groundtruth(const std::filesystem::path& file) {
         throw io_error(file, n, "cannot parse '" + tok[c] + "' in column " + std::to_string(c + 1) + " as a number");
       }
     };
+    const auto index = [&](std::size_t c) {
+      try {
+        return apps::parse_integer<long>(tok[c], 0);
+      } catch (const apps::usage_error&) {
+        throw io_error(file, n, "cannot parse '" + tok[c] + "' in column " + std::to_string(c + 1) +
+                                    " as a vertex id (a non-negative integer)");
+      }
+    };
     if (tok[0] == "EDGE2" || tok[0] == "EDGE_SE2") {
       if (tok.size() < 6) throw io_error(file, n, tok[0] + " expects at least i j dx dy dtheta");
-      const long i = std::stol(tok[1]), j = std::stol(tok[2]);
+      const long i = index(1), j = index(2);
       if (j != i + 1) continue;  // only the odometry chain
       toro = true;
       if (poses.empty()) poses.push_back(SE2<double>());

@@ -108,6 +108,9 @@ TEST_CASE("Programs keep the exit-status and one-line contract on bad input", "[
   (void)dir.write("zero_info.g2o", three + "EDGE_SE2 1 2 1 0 0 0 0 0 0 0 0\n");
   (void)dir.write("heading_only.g2o", three + "EDGE_SE2 1 2 1 0 0 0 0 0 0 0 100\n");
   (void)dir.write("no_y.g2o", three + "EDGE_SE2 1 2 1 0 0 100 0 0 0 0 100\n");
+  // A ground truth whose odometry edge names vertex "x1" on line 2.
+  (void)dir.write("two.g2o", vertices + "EDGE_SE2 0 1 1 0 0 100 0 0 100 0 100\n");
+  (void)dir.write("bad_id_gt.txt", "# i j dx dy dtheta\nEDGE2 0 x1 1 0 0\n");
 
   // EuRoC files: a recording at rest, and one with an accelerometer reading of 1e308 on line 3.
   const RestRecording rest = rest_recording(12.0);
@@ -143,6 +146,9 @@ TEST_CASE("Programs keep the exit-status and one-line contract on bad input", "[
        {"{dir}/still.tum", "--align none"},
        {"umeyama"}},
       {"optimize_pose_graph", "--input '{dir}/huge.g2o'", 1, {"{dir}/huge.g2o:3: ", "1e+308"}, {"singular"}},
+      {"optimize_pose_graph", "--input '{dir}/two.g2o' --groundtruth '{dir}/bad_id_gt.txt'", 1,
+       {"{dir}/bad_id_gt.txt:2: ", "'x1'", "vertex id"},
+       {"stol"}},
       {"optimize_pose_graph", "--input '{dir}/strong.g2o'", 1, {"{dir}/strong.g2o:3: ", "1e+300"},
        {"singular", "too weak"}},
       // A node the information leaves free is refused from every start.
