@@ -78,21 +78,23 @@ namespace apps = posefuse::apps;
 
 namespace {
 
+// Defaults are the library's (posefuse::VioEstimatorOptions and its parts),
+// except where a program needs its own (the IMU gap, the image margin).
 struct Options {
   std::filesystem::path tracks, camera, imu;
   std::optional<std::filesystem::path> groundtruth, out, out_odometry, save_map, load_map;
   std::optional<std::string> loops;  // a file, or "recurring-ids"
   double max_imu_gap_ms = 50.0;
-  double pixel_sigma_px = 1.0;
+  double pixel_sigma_px = posefuse::SlidingWindowOptions{}.pixel_sigma_px;
   int window = posefuse::SlidingWindowOptions{}.window_size;
-  int iterations = 10;
+  int iterations = posefuse::WindowSolveOptions{}.max_iterations;
   std::string loss = "cauchy";
   bool estimate_extrinsic = false;
   bool no_fej = false;
   bool no_reuse = false;
-  double min_parallax_px = 10.0;
+  double min_parallax_px = posefuse::SlidingWindowOptions{}.min_parallax_px;
   double min_keyframe_interval_s = posefuse::SlidingWindowOptions{}.min_keyframe_interval_s;
-  double outlier_px = 5.26;
+  double outlier_px = posefuse::SlidingWindowOptions{}.outlier_threshold_px;
   std::size_t max_frames = 0;
   posefuse::ImuNoise noise;  // the EuRoC IMU's datasheet figures (imu0 sensor.yaml)
   posefuse::ImuReadOptions imu_bounds;
@@ -184,22 +186,9 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
               .help = "accelerometer and gyroscope noise densities, then their random walks\n"
                       "(m/s^2/sqrt(Hz), rad/s/sqrt(Hz), m/s^3/sqrt(Hz), rad/s^2/sqrt(Hz))",
               .default_text = "2e-3,1.6968e-4,3e-3,1.9393e-5"},
-             [&](std::string_view v) {
-               double x[4];
-               std::size_t start = 0;
-               for (int i = 0; i < 4; ++i) {
-                 const std::size_t comma = i < 3 ? v.find(',', start) : v.size();
-                 if (comma == std::string_view::npos || (i == 3 && v.find(',', start) != std::string_view::npos))
-                   throw apps::usage_error("expected four comma-separated numbers, got '" + std::string(v) + "'");
-                 x[i] = apps::parse_real(v.substr(start, comma - start), apps::Domain::kPositive);
-                 // A density this small or large makes the IMU's information
-                 // overflow or vanish: it can only fail.
-                 if (!(x[i] >= 1e-8 && x[i] <= 100.0))
-                   throw apps::usage_error("each value must be from 1e-08 to 100, got '" + std::string(v) + "'");
-                 start = comma + 1;
-               }
-               o.noise = posefuse::ImuNoise{x[1], x[0], x[3], x[2]};
-             });
+             // A density this small or large makes the IMU's information
+             // overflow or vanish: it can only fail.
+             [&](std::string_view v) { o.noise = apps::parse_imu_noise(v, 1e-8); });
   cli.integer({.name = "--max-frames", .value = "N", .help = "stop after N frames (0: all)"}, o.max_frames,
               std::size_t{0});
   apps::declare_imu_bounds(cli, o.imu_bounds);
@@ -255,6 +244,7 @@ struct Summary {
     std::string how;
     double gravity_error_deg = std::numeric_limits<double>::quiet_NaN();  // with a ground truth
     double scale_error = std::numeric_limits<double>::quiet_NaN();        // with a ground truth, in motion
+    bool anchored = false;  // in the world frame of the output so far; otherwise a new one begins
   };
   std::vector<Start> start_details;
   std::size_t before_imu = 0, after_imu = 0;  // frames outside the IMU's span, not estimated
@@ -429,6 +419,9 @@ class Loops {
   }
 
   // A keyframe left the window: add it, then try the candidates it settles.
+  /// The next keyframe begins a new sequence (a start in a new world frame).
+  void start_sequence() { lc_.start_sequence(); }
+
   void add_keyframe(const posefuse::KeyframeRecord& r) {
     const std::int64_t id = lc_.add_keyframe(r);
     ++s_.keyframes;
@@ -572,6 +565,9 @@ int run(const Options& o, const std::string& program) {
     while (k < imu.size() && (k == 0 || imu[k - 1].t_ns < frame.t_ns)) est.add_imu(imu[k++]);
     const auto t0 = std::chrono::steady_clock::now();
     const posefuse::VioFrameResult r = est.add_frame(frame);
+    // A start that is not anchored begins a new world frame: no sequential
+    // edge may join its keyframes to the earlier ones.
+    if (loops && r.started && !r.anchored) loops->start_sequence();
     if (loops && r.keyframe) loops->add_keyframe(*r.keyframe);
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     ++s.frames;
@@ -579,6 +575,7 @@ int run(const Options& o, const std::string& program) {
     if (r.started) {
       ++s.starts;
       Summary::Start st{posefuse::seconds_from_ns(frame.t_ns), r.message};
+      st.anchored = r.anchored;
       if (gt) grade_start(*gt, est.window(), st);
       s.start_details.push_back(st);
     }
@@ -715,7 +712,7 @@ int run(const Options& o, const std::string& program) {
     j.key("start_details").begin_array(apps::JsonWriter::Layout::kBlock);
     for (const Summary::Start& x : s.start_details) {
       j.begin_object(apps::JsonWriter::Layout::kInline);
-      j.member("t_s", x.t_s).member("how", x.how);
+      j.member("t_s", x.t_s).member("how", x.how).member("anchored", x.anchored);
       j.member("gravity_error_deg", x.gravity_error_deg).member("scale_error", x.scale_error);
       j.end_object();
     }
@@ -775,7 +772,7 @@ int run(const Options& o, const std::string& program) {
   if (!s.failures.empty()) std::printf(" (%zu failure(s): the trajectory has a gap at each)", s.failures.size());
   std::printf("\n");
   for (const Summary::Start& x : s.start_details) {
-    std::printf("  t = %.3f s: %s", x.t_s, x.how.c_str());
+    std::printf("  t = %.3f s: %s%s", x.t_s, x.how.c_str(), x.anchored ? ", anchored to the last good state" : "");
     if (std::isfinite(x.gravity_error_deg)) std::printf("; gravity error %.2f deg", x.gravity_error_deg);
     if (std::isfinite(x.scale_error)) std::printf(", scale error %+.1f %%", 100.0 * x.scale_error);
     std::printf("\n");

@@ -166,11 +166,13 @@ TEST_CASE("VioEstimator: two seconds without features fail, and it starts again 
   CHECK(starts == 2);
   REQUIRE(restarted < r.results.size());
   CHECK(double(r.results[restarted].t_ns - r.results[0].t_ns) * 1e-9 < 8.0);  // within 2 s of vision's return
+  CHECK(r.results[restarted].anchored);  // within anchor_within_s of the last good frame
   // Anchored: after the restart the estimate stays in the first start's frame.
   // The first start's frame is the truth's moved by a yaw and a translation;
   // find them from the first start's frame and compare after the restart.
   std::size_t s = 0;
   while (!r.results[s].started) ++s;
+  CHECK_FALSE(r.results[s].anchored);  // the first start has nothing to be anchored to
   const auto yaw = [](const SO3d& R) { return std::atan2(R.matrix()(1, 0), R.matrix()(0, 0)); };
   const SO3d dR = SO3d::exp(Eigen::Vector3d(0, 0, yaw(r.truth[s].R_w_b) - yaw(r.results[s].state.R)));
   const Eigen::Vector3d dt = r.truth[s].p_w - dR.act(r.results[s].state.p);

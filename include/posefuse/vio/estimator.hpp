@@ -142,6 +142,10 @@ struct VioFrameResult {
   int iterations = 0;                        ///< LM trials of its solve
   std::string message;                       ///< why initializing or failed; how a start was made
   bool started = false;                      ///< a start (or restart) was made with this frame
+  /// With `started`: the start was anchored to the last good state (same
+  /// world frame as before). A start that is not anchored begins a new
+  /// world frame: position 0 and yaw 0 at its first frame.
+  bool anchored = false;
   /// Set when a keyframe left the window with this frame (its pose and
   /// triangulated features are then final for the odometry).
   std::optional<KeyframeRecord> keyframe;
@@ -157,7 +161,7 @@ class VioEstimator {
     w_.T_bc = RigidPose{camera.T_BS.translation(), SO3d(Eigen::Quaterniond(camera.T_BS.rotation()).normalized())};
     w_.gravity_w = Eigen::Vector3d(0, 0, -o.static_init.gravity_mps2);
     w_.sqrt_info = Eigen::Vector2d(camera.fu, camera.fv) / o.window.pixel_sigma_px;
-    o_.window.focal_px = 0.5 * (camera.fu + camera.fv);
+    o_.window.focal_px = 0.5 * (camera.fu + camera.fv);  // the camera's, whatever o says (SlidingWindowOptions)
     if (o_.dynamic_init.frames < 4)
       throw invalid_argument("VioEstimator: dynamic_init.frames " + std::to_string(o_.dynamic_init.frames) + " < 4");
     o_.dynamic_init.frames = std::max(4, std::min(o_.dynamic_init.frames, o_.window.window_size + 1));
@@ -183,7 +187,7 @@ class VioEstimator {
     res.t_ns = frame.t_ns;
     // No frame (hence no feature) for longer than the loss bound.
     if (const double gap_s = seconds_between(frame.t_ns, w_.frames.back().t_ns); gap_s > o_.failure.max_lost_s)
-      return fail(res, "no frame for " + format_seconds(gap_s) + " s");
+      return fail(res, "no frame for " + format_number(gap_s) + " s");
     VioFrame f;
     f.t_ns = frame.t_ns;
     f.id = next_id_++;
@@ -231,7 +235,7 @@ class VioEstimator {
       const double lost_s = seconds_between(frame.t_ns, *lost_since_);
       if (lost_s > o_.failure.max_lost_s)
         return fail(res, "fewer than " + std::to_string(o_.min_features) + " tracked features for " +
-                             format_seconds(lost_s) + " s");
+                             format_number(lost_s) + " s");
     }
     res.state = w_.frames.back().x;
     if (res.status == VioStatus::kTracking) {
@@ -261,6 +265,7 @@ class VioEstimator {
   VioFrameResult start(const TrackFrame& frame) {
     VioFrameResult res;
     res.t_ns = frame.t_ns;
+    anchored_ = false;
     if (initial_) {
       const ImuState x0 = *initial_;
       initial_.reset();
@@ -281,7 +286,7 @@ class VioEstimator {
       // In kAuto the images must show rest too (a smooth flight can pass the IMU's test).
       const bool images_agree = o_.init == VioInit::kStatic || image_rest_s >= 0.9 * o_.static_init.duration_s;
       if (si.state && !images_agree)
-        why = "static start: the features moved during the last " + format_seconds(o_.static_init.duration_s) +
+        why = "static start: the features moved during the last " + format_number(o_.static_init.duration_s) +
               " s";
       else if (si.state) {
         begin(frame, anchored(frame.t_ns, *si.state, frame.t_ns), /*at_rest=*/true);
@@ -297,7 +302,7 @@ class VioEstimator {
       if (d.ok) {
         begin_in_motion(d);
         res.message = "started in motion (" + std::to_string(d.states.size()) + " frames over " +
-                      format_seconds(seconds_between(d.t_ns.back(), d.t_ns.front())) + " s, scale " +
+                      format_number(seconds_between(d.t_ns.back(), d.t_ns.front())) + " s, scale " +
                       std::to_string(d.scale) + ")";
         res.features = features_in_newest();
         return started(res);
@@ -337,6 +342,7 @@ class VioEstimator {
     buffer_.clear();
     rest_ref_ = {};
     res.started = true;
+    res.anchored = anchored_;
     res.status = res.features >= o_.min_features ? VioStatus::kTracking : VioStatus::kNotEnoughFeatures;
     res.state = w_.frames.back().x;
     last_good_ = res.state;
@@ -389,7 +395,9 @@ class VioEstimator {
   // start's first frame) moved in position and yaw to the last good state
   // carried through the IMU, when that is recent enough (file comment).
   // `t_newest_ns` bounds the samples the carry may need.
-  [[nodiscard]] ImuState anchored(std::int64_t t_ns, const ImuState& x, std::int64_t t_newest_ns) const {
+  // Records in anchored_ whether it anchored `x`.
+  [[nodiscard]] ImuState anchored(std::int64_t t_ns, const ImuState& x, std::int64_t t_newest_ns) {
+    anchored_ = false;
     if (starts_ == 0 || !last_good_t_ns_ || t_ns <= *last_good_t_ns_ ||
         seconds_between(t_ns, *last_good_t_ns_) > o_.failure.anchor_within_s || t_newest_ns < t_ns)
       return x;
@@ -405,6 +413,7 @@ class VioEstimator {
     out.R = dyaw.compose(x.R);
     out.v = dyaw.act(x.v);
     out.p = carried.p;
+    anchored_ = true;
     return out;
   }
 
@@ -430,27 +439,27 @@ class VioEstimator {
     const ImuState& x = w_.frames.back().x;
     const VioFailureOptions& f = o_.failure;
     if (x.v.norm() > o_.max_speed_mps)
-      return "speed " + format_seconds(x.v.norm()) + " m/s above " + format_seconds(o_.max_speed_mps) + " m/s";
+      return "speed " + format_number(x.v.norm()) + " m/s above " + format_number(o_.max_speed_mps) + " m/s";
     if (x.bias.accel.norm() > f.max_accel_bias_mps2)
-      return "accelerometer bias " + format_seconds(x.bias.accel.norm()) + " m/s^2 above " +
-             format_seconds(f.max_accel_bias_mps2);
+      return "accelerometer bias " + format_number(x.bias.accel.norm()) + " m/s^2 above " +
+             format_number(f.max_accel_bias_mps2);
     if (x.bias.gyro.norm() > f.max_gyro_bias_radps)
-      return "gyroscope bias " + format_seconds(x.bias.gyro.norm()) + " rad/s above " +
-             format_seconds(f.max_gyro_bias_radps);
+      return "gyroscope bias " + format_number(x.bias.gyro.norm()) + " rad/s above " +
+             format_number(f.max_gyro_bias_radps);
     const double dp = (x.p - predicted.p).norm();
     if (dp > f.max_position_jump_m)
-      return "the position jumped " + format_seconds(dp) + " m from its IMU prediction (bound " +
-             format_seconds(f.max_position_jump_m) + " m)";
+      return "the position jumped " + format_number(dp) + " m from its IMU prediction (bound " +
+             format_number(f.max_position_jump_m) + " m)";
     const double dr = predicted.R.inverse().compose(x.R).log().norm();
     if (dr > f.max_rotation_jump_rad)
-      return "the attitude jumped " + format_seconds(dr * 180.0 / 3.14159265358979) +
-             " deg from its IMU prediction (bound " + format_seconds(f.max_rotation_jump_rad * 180.0 / 3.14159265358979) +
+      return "the attitude jumped " + format_number(dr * 180.0 / 3.14159265358979) +
+             " deg from its IMU prediction (bound " + format_number(f.max_rotation_jump_rad * 180.0 / 3.14159265358979) +
              " deg)";
     return {};
   }
 
-  // A number with up to three decimals, for messages.
-  [[nodiscard]] static std::string format_seconds(double v) {
+  // A number to three significant digits, for messages.
+  [[nodiscard]] static std::string format_number(double v) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.3g", v);
     return buf;
@@ -580,6 +589,7 @@ class VioEstimator {
   std::optional<std::int64_t> last_good_t_ns_;
   std::optional<std::int64_t> lost_since_;
   int starts_ = 0;
+  bool anchored_ = false;  // the last start was anchored (see anchored())
   std::uint64_t next_id_ = 1;
 };
 

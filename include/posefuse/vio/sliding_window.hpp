@@ -73,7 +73,10 @@ struct SlidingWindowOptions {
   /// seconds of accelerometer rather than one.
   double min_keyframe_interval_s = 0.25;
   int min_tracked = 20;                      ///< keyframe test: fewer shared features makes a keyframe
-  double focal_px = 460.0;                   ///< focal length that converts parallax to pixels
+  /// Focal length (px) that converts parallax to pixels; VioEstimator sets
+  /// it (and the start's SfM's) to the camera's mean of fu and fv, so a
+  /// value given here matters only to direct callers of the window functions.
+  double focal_px = 460.0;
   double pixel_sigma_px = 1.0;               ///< σ of the reprojection residuals
   /// Reprojection error above this is an outlier: the 99.9 % bound of χ²(2)
   /// for a residual of variance 2σ² per axis (the anchor's pixel noise and
@@ -104,10 +107,10 @@ inline int triangulate_features(VioWindow& w, const SlidingWindowOptions& o) {
   return n;
 }
 
-/// Calls f(|m_a - m_b|) (normalised coordinates) for every landmark seen in
+/// Calls f(m_a, m_b) (normalised coordinates) for every landmark seen in
 /// both frames `a` and `b`, in the window's landmark order.
 template <class F>
-void for_each_shared_displacement(const VioWindow& w, std::uint64_t a, std::uint64_t b, F f) {
+void for_each_shared_pair(const VioWindow& w, std::uint64_t a, std::uint64_t b, F f) {
   for (const auto& [id, l] : w.landmarks) {
     const VioObservation* oa = nullptr;
     const VioObservation* ob = nullptr;
@@ -115,7 +118,7 @@ void for_each_shared_displacement(const VioWindow& w, std::uint64_t a, std::uint
       if (o.frame_id == a) oa = &o;
       if (o.frame_id == b) ob = &o;
     }
-    if (oa && ob) f((oa->m - ob->m).norm());
+    if (oa && ob) f(oa->m, ob->m);
   }
 }
 
@@ -135,24 +138,17 @@ void for_each_shared_displacement(const VioWindow& w, std::uint64_t a, std::uint
   const std::uint64_t a = w.frames[slot - 1].id, b = w.frames[slot].id;
   double sum = 0.0;
   int shared = 0;
-  for (const auto& [id, l] : w.landmarks) {
-    const VioObservation* oa = nullptr;
-    const VioObservation* ob = nullptr;
-    for (const VioObservation& o : l.obs) {
-      if (o.frame_id == a) oa = &o;
-      if (o.frame_id == b) ob = &o;
-    }
-    if (!oa || !ob) continue;
-    Eigen::Vector2d ma = oa->m;
+  for_each_shared_pair(w, a, b, [&](const Eigen::Vector2d& m_a, const Eigen::Vector2d& m_b) {
+    Eigen::Vector2d ma = m_a;
     if (rotation_compensated) {
       const Eigen::Vector3d r = M * Eigen::Vector3d(ma.x(), ma.y(), 1.0);
       // Behind the newer camera after rotation: no meaningful image displacement.
-      if (!(r.z() > 1e-6)) continue;
+      if (!(r.z() > 1e-6)) return;
       ma = r.head<2>() / r.z();
     }
-    sum += (ob->m - ma).norm();
+    sum += (m_b - ma).norm();
     ++shared;
-  }
+  });
   return {shared > 0 ? sum / shared * focal_px : 0.0, shared};
 }
 
@@ -178,8 +174,8 @@ void for_each_shared_displacement(const VioWindow& w, std::uint64_t a, std::uint
                                         const SlidingWindowOptions& o) {
   if (ref >= slot || slot >= w.frames.size()) return false;
   std::vector<double> d;
-  for_each_shared_displacement(w, w.frames[ref].id, w.frames[slot].id,
-                               [&](double m) { d.push_back(m * o.focal_px); });
+  for_each_shared_pair(w, w.frames[ref].id, w.frames[slot].id,
+                       [&](const Eigen::Vector2d& ma, const Eigen::Vector2d& mb) { d.push_back((ma - mb).norm() * o.focal_px); });
   if (int(d.size()) < o.min_tracked) return false;
   const auto mid = d.begin() + std::ptrdiff_t(d.size() / 2);
   std::nth_element(d.begin(), mid, d.end());
