@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The library's exception types and its debug assertion.
+/// The library's exception types.
 ///
 /// posefuse reports three kinds of failure differently (docs/design.md,
 /// "Errors"): bad configuration throws posefuse::invalid_argument, unreadable
@@ -55,16 +55,3 @@ class io_error : public std::runtime_error {
 };
 
 }  // namespace posefuse
-
-#ifdef NDEBUG
-#define POSEFUSE_ASSERT(cond, msg) ((void)0)
-#else
-#include <cstdio>
-#include <cstdlib>
-/// Checks an internal invariant in debug builds; compiled out under NDEBUG.
-#define POSEFUSE_ASSERT(cond, msg)                                                    \
-  ((cond) ? (void)0                                                                   \
-          : (std::fprintf(stderr, "%s:%d: posefuse assertion '%s' failed: %s\n",      \
-                          __FILE__, __LINE__, #cond, msg),                            \
-             std::abort()))
-#endif

@@ -34,8 +34,8 @@ namespace posefuse::detail {
 template <class Lazy = void>
 [[nodiscard]] std::vector<int> block_amd_order(int n, const std::vector<std::pair<int, int>>& pairs) {
   // The block graph's full symmetric pattern with its diagonal, sorted by
-  // row within each column, built directly (counting sort) as Eigen's
-  // minimum_degree_ordering wants it; parallel edges are merged.
+  // row within each column, built directly (counting sort); parallel edges
+  // are merged.
   std::vector<int> count(std::size_t(n) + 1, 0);
   for (const auto& e : pairs) {
     if (e.first < 0 || e.second < 0 || e.first == e.second) continue;
@@ -71,7 +71,7 @@ template <class Lazy = void>
   }
   A.outerIndexPtr()[n] = q;
   Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> Pinv;
-  Eigen::internal::minimum_degree_ordering(A, Pinv);  // what Eigen::AMDOrdering runs after symmetrising
+  Eigen::AMDOrdering<int>()(A, Pinv);  // A is symmetric: its A + A^T has the same pattern
   // Eigen's solvers factor P A P^T with P = Pinv^{-1}: old index i goes to P(i).
   const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> P = Pinv.inverse();
   std::vector<int> position(static_cast<std::size_t>(n));
@@ -368,9 +368,6 @@ class BlockCholesky {
       y.template segment<B>(j * B).noalias() = Ldinv_[std::size_t(j)].transpose() * yj;
     }
   }
-
-  /// Number of strictly lower blocks of L.
-  [[nodiscard]] std::size_t factor_blocks() const noexcept { return Li_.size(); }
 
   /// Bytes of heap storage held (capacity, the factor and its work arrays).
   [[nodiscard]] std::size_t capacity_bytes() const noexcept {
