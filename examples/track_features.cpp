@@ -70,6 +70,14 @@ std::optional<Options> parse_options(const apps::CommandLine& cmd) {
   if (!cli.parse(cmd)) return std::nullopt;
   if (!o.images) throw apps::usage_error("--images is required");
   if (!o.out) throw apps::usage_error("--out is required");
+  // The parser refuses --out equal to --images; it must not name a file the
+  // run reads inside the folder either.
+  const std::filesystem::path out_key = apps::path_key(*o.out);
+  if (out_key == apps::path_key(*o.images / "data.csv") ||
+      (!o.camera && out_key == apps::path_key(*o.images / "sensor.yaml")) ||
+      out_key.parent_path() == apps::path_key(*o.images / "data"))
+    throw apps::usage_error("--out " + o.out->string() + " names a file that --images " + o.images->string() +
+                            " reads");
   t.validate();  // every field is bounded by its flag above; a failure here is a bug
   return o;
 }
