@@ -66,7 +66,8 @@ TEST_CASE("KLT: a translated texture is tracked to within 0.1 px", "[frontend]")
   const cv::Mat tex = syn::texture();
   const cv::Mat img0 = syn::view(tex, 0, 0);
   // A sub-pixel shift and one of several pixels.
-  for (const auto& [dx, dy] : {std::pair{0.37, -0.62}, std::pair{6.4, 3.75}, std::pair{-11.25, 8.5}}) {
+  for (const auto& shift : {std::pair{0.37, -0.62}, std::pair{6.4, 3.75}, std::pair{-11.25, 8.5}}) {
+    const double dx = shift.first, dy = shift.second;  // not a structured binding: clang 14 cannot capture one
     CAPTURE(dx, dy);
     pf::KltTracker tracker(syn::pinhole());
     const pf::KltFrameStats s0 = tracker.track(1, img0);
@@ -94,7 +95,9 @@ TEST_CASE("KLT: a rotated and zoomed texture is tracked to sub-pixel accuracy", 
   // 0.5 deg and 0.5 % (10 deg/s at 20 Hz), within 0.2 px at 1.5 deg and 2 %.
   const cv::Mat tex = syn::texture();
   constexpr double kDeg = 3.14159265358979 / 180.0;
-  for (const auto& [angle, scale, bound] : {std::tuple{0.5 * kDeg, 1.005, 0.1}, std::tuple{1.5 * kDeg, 1.02, 0.2}}) {
+  for (const auto& motion : {std::tuple{0.5 * kDeg, 1.005, 0.1}, std::tuple{1.5 * kDeg, 1.02, 0.2}}) {
+    const auto [angle_, scale_, bound] = motion;
+    const double angle = angle_, scale = scale_;  // plain variables: clang 14 cannot capture a structured binding
     CAPTURE(angle, scale);
     pf::KltTracker tracker(syn::pinhole());
     tracker.track(1, syn::view(tex, 0, 0));
