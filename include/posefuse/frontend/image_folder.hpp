@@ -64,11 +64,11 @@ class EurocImageFolder {
     while (reader.next(line)) {
       const std::size_t n = reader.line_no();
       if (detail::traj_io::is_blank_or_comment(line)) continue;
-      const std::vector<std::string_view> f = detail::euroc_io::split_csv(line);
+      const std::vector<std::string_view> f = detail::split_csv(line);
       if (f.size() != 2)
         throw io_error(csv_, n,
                        "expected 2 comma-separated fields (t_ns,filename), found " + std::to_string(f.size()));
-      const std::int64_t t = detail::euroc_io::parse_stamp(f[0], csv_, n);
+      const std::int64_t t = detail::parse_stamp(f[0], csv_, n);
       if (previous_line > 0) detail::euroc_io::check_order(t, previous, previous_line, csv_, n);
       if (f[1].empty()) throw io_error(csv_, n, "empty file name");
       const fs::path name(f[1]);
